@@ -1,0 +1,14 @@
+#pragma once
+// One function per subcommand: adds it to the CLI with its options and the callback that runs
+// it. Callbacks throw parallax's exceptions; main() maps them to exit codes.
+#include <CLI/CLI.hpp>
+
+namespace parallax {
+
+void RegisterSynthCommand(CLI::App& app);
+
+// A subcommand whose stage has not been built yet: it says so and exits with code 1.
+void RegisterPendingCommand(CLI::App& app, const std::string& name,
+                            const std::string& description);
+
+}  // namespace parallax

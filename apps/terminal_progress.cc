@@ -1,0 +1,29 @@
+#include "apps/terminal_progress.h"
+
+namespace parallax {
+
+TerminalProgress::~TerminalProgress() {
+  if (line_open_) std::fputc('\n', stream_);
+}
+
+void TerminalProgress::Update(std::string_view stage, int64_t done, int64_t total) {
+  const auto now = std::chrono::steady_clock::now();
+  if (stage != stage_) {
+    if (line_open_) std::fputc('\n', stream_);
+    stage_ = stage;
+    stage_start_ = now;
+  }
+  const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
+  std::fprintf(stream_, "\r%-12s %lld/%lld  %6.1f s", stage_.c_str(),
+               static_cast<long long>(done), static_cast<long long>(total), elapsed);
+  if (done > 0 && done < total) {
+    std::fprintf(stream_, "  eta %5.1f s", elapsed / static_cast<double>(done) *
+                                               static_cast<double>(total - done));
+  } else {
+    std::fputs("            ", stream_);
+  }
+  std::fflush(stream_);
+  line_open_ = true;
+}
+
+}  // namespace parallax

@@ -1,0 +1,23 @@
+#pragma once
+// Writes that never leave a half-written file under the final name: write to a temporary
+// name beside the target, then rename (atomic within one file system).
+#include <filesystem>
+#include <functional>
+#include <string_view>
+
+namespace parallax {
+
+// Calls `write(temporary_path)`, then renames the temporary file to `path`. Creates the parent
+// folder. If `write` throws, the temporary file is removed and the exception propagates; an
+// existing file at `path` is left untouched. Throws BadInputError if the folder is not
+// writable.
+void WriteAtomically(const std::filesystem::path& path,
+                     const std::function<void(const std::filesystem::path&)>& write);
+
+// Writes `bytes` to `path` atomically.
+void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+// Whole file as bytes; throws BadInputError naming the file if it cannot be read.
+std::string ReadFileBytes(const std::filesystem::path& path);
+
+}  // namespace parallax

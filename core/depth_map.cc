@@ -1,0 +1,170 @@
+#include "core/depth_map.h"
+
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/oiio_metadata.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "COLMAP's dense format is little-endian; a big-endian port must swap bytes");
+
+// Index of the first value that is not a valid depth (finite and >= 0), or -1.
+int64_t FindInvalidDepth(const std::vector<float>& values) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i]) || values[i] < 0) return static_cast<int64_t>(i);
+  }
+  return -1;
+}
+
+std::string DescribeInvalidDepth(const std::vector<float>& values, int64_t index) {
+  return "depth value " + std::to_string(values[static_cast<size_t>(index)]) + " at index " +
+         std::to_string(index) + " (depth must be finite and >= 0)";
+}
+
+// For readers: a bad value in a file is bad input.
+void CheckReadDepth(const std::vector<float>& values, const fs::path& path) {
+  const int64_t bad = FindInvalidDepth(values);
+  if (bad >= 0) throw BadInputError(path.string() + ": " + DescribeInvalidDepth(values, bad));
+}
+
+// For writers: a bad value in memory is the caller's bug.
+void CheckWrittenDepth(const DepthMap& depth, const fs::path& path) {
+  const int64_t bad = FindInvalidDepth(depth.Values());
+  if (bad >= 0) {
+    throw std::invalid_argument("writing " + path.string() + ": " +
+                                DescribeInvalidDepth(depth.Values(), bad));
+  }
+}
+
+// Parses one "<number>&" field of the dense header starting at `position`.
+int ParseHeaderField(const std::string& bytes, size_t& position, const fs::path& path,
+                     const char* field) {
+  const size_t end = bytes.find('&', position);
+  int value = -1;
+  if (end == std::string::npos || end - position > 10) {
+    throw BadInputError(path.string() + ": malformed dense header (" + field + ")");
+  }
+  const auto result = std::from_chars(bytes.data() + position, bytes.data() + end, value);
+  if (result.ec != std::errc() || result.ptr != bytes.data() + end || value <= 0) {
+    throw BadInputError(path.string() + ": malformed dense header: " + field + " '" +
+                        bytes.substr(position, end - position) + "'");
+  }
+  position = end + 1;
+  return value;
+}
+
+}  // namespace
+
+DepthMap::DepthMap(int width, int height) : width_(width), height_(height) {
+  if (width < 0 || height < 0) {
+    throw std::invalid_argument("DepthMap: invalid size " + std::to_string(width) + "x" +
+                                std::to_string(height));
+  }
+  values_.assign(static_cast<size_t>(width) * height, 0.0f);
+}
+
+DepthMap ReadDepthExr(const fs::path& path) {
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) throw BadInputError("cannot read depth " + path.string() + ": " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.nchannels != 1) {
+    throw BadInputError("depth " + path.string() + " has " + std::to_string(spec.nchannels) +
+                        " channels; a depth map has one");
+  }
+  DepthMap depth(spec.width, spec.height);
+  if (!input->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, depth.Values().data())) {
+    throw BadInputError("depth " + path.string() + " is corrupt: " + input->geterror());
+  }
+  CheckReadDepth(depth.Values(), path);
+  return depth;
+}
+
+void WriteDepthExr(const fs::path& path, const DepthMap& depth) {
+  CheckWrittenDepth(depth, path);
+  WriteAtomically(path, [&](const fs::path& temporary) {
+    auto output = OIIO::ImageOutput::create("exr");
+    OIIO::ImageSpec spec(depth.Width(), depth.Height(), 1, OIIO::TypeDesc::FLOAT);
+    spec.channelnames = {"Z"};
+    spec.attribute("compression", "zip");
+    SetReproducibleMetadata(spec);
+    if (!output || !output->open(temporary.string(), spec) ||
+        !output->write_image(OIIO::TypeDesc::FLOAT, depth.Values().data()) || !output->close()) {
+      throw BadInputError("cannot write " + path.string() +
+                          (output ? ": " + output->geterror() : std::string()));
+    }
+  });
+}
+
+DenseArray ReadColmapArray(const fs::path& path) {
+  const std::string bytes = ReadFileBytes(path);
+  size_t position = 0;
+  DenseArray array;
+  array.width = ParseHeaderField(bytes, position, path, "width");
+  array.height = ParseHeaderField(bytes, position, path, "height");
+  array.channels = ParseHeaderField(bytes, position, path, "channels");
+  // Sizes are checked against the data actually present, in 64-bit, before any allocation.
+  const uint64_t count = static_cast<uint64_t>(array.width) * static_cast<uint64_t>(array.height) *
+                         static_cast<uint64_t>(array.channels);
+  const uint64_t available = bytes.size() - position;
+  if (count * sizeof(float) != available) {
+    throw BadInputError(path.string() + ": header says " + std::to_string(array.width) + "x" +
+                        std::to_string(array.height) + "x" + std::to_string(array.channels) +
+                        " (" + std::to_string(count * sizeof(float)) + " bytes of data), file has " +
+                        std::to_string(available));
+  }
+  array.values.resize(count);
+  std::memcpy(array.values.data(), bytes.data() + position, available);
+  for (const float value : array.values) {
+    if (!std::isfinite(value)) throw BadInputError(path.string() + ": NaN or Inf in the data");
+  }
+  return array;
+}
+
+void WriteColmapArray(const fs::path& path, const DenseArray& array) {
+  const size_t count = static_cast<size_t>(array.width) * array.height * array.channels;
+  if (array.width <= 0 || array.height <= 0 || array.channels <= 0 || array.values.size() != count) {
+    throw std::invalid_argument("WriteColmapArray " + path.string() + ": size does not match data");
+  }
+  for (const float value : array.values) {
+    if (!std::isfinite(value)) {
+      throw std::invalid_argument("WriteColmapArray " + path.string() + ": NaN or Inf in data");
+    }
+  }
+  std::string bytes = std::to_string(array.width) + "&" + std::to_string(array.height) + "&" +
+                      std::to_string(array.channels) + "&";
+  const size_t header_size = bytes.size();
+  bytes.resize(header_size + count * sizeof(float));
+  std::memcpy(bytes.data() + header_size, array.values.data(), count * sizeof(float));
+  WriteFileAtomically(path, bytes);
+}
+
+DepthMap ReadColmapDepth(const fs::path& path) {
+  DenseArray array = ReadColmapArray(path);
+  if (array.channels != 1) {
+    throw BadInputError(path.string() + ": depth map has " + std::to_string(array.channels) +
+                        " channels; expected 1");
+  }
+  CheckReadDepth(array.values, path);
+  DepthMap depth(array.width, array.height);
+  depth.Values() = std::move(array.values);
+  return depth;
+}
+
+void WriteColmapDepth(const fs::path& path, const DepthMap& depth) {
+  CheckWrittenDepth(depth, path);
+  WriteColmapArray(path, DenseArray{depth.Width(), depth.Height(), 1, depth.Values()});
+}
+
+}  // namespace parallax

@@ -1,0 +1,60 @@
+#pragma once
+// Depth maps: float32 z-depth along the optical axis, in scene units, one value per pixel
+// centre. 0 means "no value" (invalid, sky, not estimated). Never NaN or Inf: constructors of
+// depth maps from files reject them, writers refuse them.
+//
+// Two file formats: single-channel EXR (our convention) and COLMAP's dense array `.bin`
+// (ASCII header "W&H&C&", then little-endian float32, channel-major: index (c*H + row)*W + col),
+// which also carries normal maps (3 channels).
+#include <filesystem>
+#include <vector>
+
+namespace parallax {
+
+class DepthMap {
+ public:
+  DepthMap() = default;
+  // Zero-filled ("no value" everywhere). Throws std::invalid_argument for negative sizes.
+  DepthMap(int width, int height);
+
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  bool Empty() const { return values_.empty(); }
+  float& At(int x, int y) { return values_[static_cast<size_t>(y) * width_ + x]; }
+  float At(int x, int y) const { return values_[static_cast<size_t>(y) * width_ + x]; }
+  std::vector<float>& Values() { return values_; }
+  const std::vector<float>& Values() const { return values_; }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<float> values_;
+};
+
+// A COLMAP dense array: `channels` planes of width x height floats, channel-major.
+struct DenseArray {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  std::vector<float> values;  // Index (c * height + row) * width + col.
+};
+
+// Reads a depth EXR with exactly one channel, whatever its name ("Z", "Y", "R", ...).
+// Throws BadInputError naming the file for a missing/corrupt file, several channels, negative
+// values, NaN or Inf.
+DepthMap ReadDepthExr(const std::filesystem::path& path);
+// Writes one float32 channel named "Z", ZIP-compressed (lossless), atomically. Throws
+// std::invalid_argument for negative, NaN or Inf values.
+void WriteDepthExr(const std::filesystem::path& path, const DepthMap& depth);
+
+// COLMAP dense `.bin`. The reader checks the header against the file size before allocating
+// (a lying header is BadInputError, not a huge allocation) and rejects NaN/Inf.
+DenseArray ReadColmapArray(const std::filesystem::path& path);
+void WriteColmapArray(const std::filesystem::path& path, const DenseArray& array);
+
+// Depth through the dense format (one channel); the reader rejects other channel counts and
+// negative values.
+DepthMap ReadColmapDepth(const std::filesystem::path& path);
+void WriteColmapDepth(const std::filesystem::path& path, const DepthMap& depth);
+
+}  // namespace parallax

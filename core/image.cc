@@ -1,0 +1,130 @@
+#include "core/image.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/oiio_metadata.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+OIIO::TypeDesc ToTypeDesc(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kUint8: return OIIO::TypeDesc::UINT8;
+    case PixelFormat::kUint16: return OIIO::TypeDesc::UINT16;
+    case PixelFormat::kHalf: return OIIO::TypeDesc::HALF;
+    case PixelFormat::kFloat: return OIIO::TypeDesc::FLOAT;
+  }
+  throw std::invalid_argument("unknown pixel format");
+}
+
+bool HasAlpha(const Image& image) { return image.Channels() == 2 || image.Channels() == 4; }
+
+Image MapColorChannels(const Image& input, float (*function)(float)) {
+  Image output = input;
+  const int colour_channels = HasAlpha(input) ? input.Channels() - 1 : input.Channels();
+  std::vector<float>& pixels = output.Pixels();
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    if (static_cast<int>(i % static_cast<size_t>(input.Channels())) < colour_channels) {
+      pixels[i] = function(pixels[i]);
+    }
+  }
+  return output;
+}
+
+}  // namespace
+
+Image::Image(int width, int height, int channels)
+    : width_(width), height_(height), channels_(channels) {
+  if (width < 0 || height < 0 || channels < 1 || channels > 4) {
+    throw std::invalid_argument("Image: invalid size " + std::to_string(width) + "x" +
+                                std::to_string(height) + "x" + std::to_string(channels));
+  }
+  pixels_.assign(static_cast<size_t>(width) * height * channels, 0.0f);
+}
+
+Image ReadImage(const fs::path& path) {
+  // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG colour by alpha.
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);
+  auto input = OIIO::ImageInput::open(path.string(), &config);
+  if (!input) {
+    throw BadInputError("cannot read image " + path.string() + ": " + OIIO::geterror());
+  }
+  const OIIO::ImageSpec& spec = input->spec();
+  if (spec.nchannels < 1 || spec.nchannels > 4) {
+    throw BadInputError("image " + path.string() + " has " + std::to_string(spec.nchannels) +
+                        " channels; parallax reads 1 to 4");
+  }
+  if (spec.depth != 1) {
+    throw BadInputError("image " + path.string() + " is a volume; parallax reads 2D images");
+  }
+  Image image(spec.width, spec.height, spec.nchannels);
+  // Integer formats are scaled to [0, 1] by OpenImageIO when read as float.
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,
+                         image.Pixels().data())) {
+    throw BadInputError("image " + path.string() + " is corrupt or truncated: " +
+                        input->geterror());
+  }
+  for (const float value : image.Pixels()) {
+    if (!std::isfinite(value)) {
+      throw BadInputError("image " + path.string() + " contains NaN or Inf values");
+    }
+  }
+  return image;
+}
+
+void WriteImage(const fs::path& path, const Image& image, PixelFormat format) {
+  if (image.Empty()) throw std::invalid_argument("WriteImage " + path.string() + ": empty image");
+  for (const float value : image.Pixels()) {
+    if (!std::isfinite(value)) {
+      throw std::invalid_argument("WriteImage " + path.string() + ": NaN or Inf in the image");
+    }
+  }
+  WriteAtomically(path, [&](const fs::path& temporary) {
+    // The plugin is chosen from the final name's extension; the data goes to the temporary.
+    auto output = OIIO::ImageOutput::create(path.string());
+    if (!output) {
+      throw BadInputError("cannot write " + path.string() + ": " + OIIO::geterror());
+    }
+    OIIO::ImageSpec spec(image.Width(), image.Height(), image.Channels(), ToTypeDesc(format));
+    if (image.Channels() == 1) spec.channelnames = {"Y"};
+    if (HasAlpha(image)) {
+      spec.alpha_channel = image.Channels() - 1;
+      spec.attribute("oiio:UnassociatedAlpha", 1);  // Colour is not premultiplied.
+    }
+    spec.attribute("compression", "zip");
+    SetReproducibleMetadata(spec);
+    if (!output->open(temporary.string(), spec) ||
+        !output->write_image(OIIO::TypeDesc::FLOAT, image.Pixels().data()) ||
+        !output->close()) {
+      throw BadInputError("cannot write " + path.string() + ": " + output->geterror());
+    }
+  });
+}
+
+float SrgbToLinear(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+float LinearToSrgb(float linear) {
+  return linear <= 0.0031308f ? linear * 12.92f
+                              : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+Image SrgbToLinear(const Image& encoded) {
+  return MapColorChannels(encoded, static_cast<float (*)(float)>(&SrgbToLinear));
+}
+
+Image LinearToSrgb(const Image& linear) {
+  return MapColorChannels(linear, static_cast<float (*)(float)>(&LinearToSrgb));
+}
+
+}  // namespace parallax

@@ -1,0 +1,67 @@
+#pragma once
+// Images in memory and on disk (through OpenImageIO: PNG, JPEG, TIFF, EXR, ...).
+//
+// Common principles:
+//  - In memory an image is float, interleaved, row-major, with 1..4 channels, holding the
+//    values the file holds scaled to [0, 1] for integer formats. No colour conversion happens
+//    behind the caller's back: 8-bit files are sRGB-encoded, EXR files are linear, and the
+//    caller converts explicitly with SrgbToLinear / LinearToSrgb.
+//  - Readers throw BadInputError naming the file and the problem; writers refuse NaN or Inf
+//    and write through a temporary file.
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace parallax {
+
+class Image {
+ public:
+  Image() = default;
+  // Zero-filled. Throws std::invalid_argument for channels outside 1..4 or negative sizes.
+  Image(int width, int height, int channels);
+
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  int Channels() const { return channels_; }
+  bool Empty() const { return pixels_.empty(); }
+
+  float& At(int x, int y, int channel) {
+    return pixels_[(static_cast<size_t>(y) * width_ + x) * channels_ + channel];
+  }
+  float At(int x, int y, int channel) const {
+    return pixels_[(static_cast<size_t>(y) * width_ + x) * channels_ + channel];
+  }
+  float* Row(int y) { return pixels_.data() + static_cast<size_t>(y) * width_ * channels_; }
+  const float* Row(int y) const {
+    return pixels_.data() + static_cast<size_t>(y) * width_ * channels_;
+  }
+  std::vector<float>& Pixels() { return pixels_; }
+  const std::vector<float>& Pixels() const { return pixels_; }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  int channels_ = 0;
+  std::vector<float> pixels_;
+};
+
+// How values are stored in a written file.
+enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
+
+// Reads any format OpenImageIO knows. Throws BadInputError (missing, unreadable, corrupt or
+// truncated file, more than 4 channels) naming the file.
+Image ReadImage(const std::filesystem::path& path);
+
+// Writes `image` in the format the extension names, integer formats rounding [0, 1] values
+// (clamped). Throws std::invalid_argument if a value is NaN or Inf, BadInputError if the file
+// cannot be written. EXR is written with lossless ZIP compression.
+void WriteImage(const std::filesystem::path& path, const Image& image, PixelFormat format);
+
+// sRGB transfer function (IEC 61966-2-1) on the colour channels; alpha (channel 4, or 2 of a
+// grey+alpha image) is left as it is.
+float SrgbToLinear(float encoded);
+float LinearToSrgb(float linear);
+Image SrgbToLinear(const Image& encoded);
+Image LinearToSrgb(const Image& linear);
+
+}  // namespace parallax

@@ -1,0 +1,27 @@
+#pragma once
+// Paths of the scene-folder layout (DESIGN.md): what `synth` writes and `evaluate` reads.
+#include <filesystem>
+#include <string>
+
+namespace parallax {
+
+// One set of views with ground truth: the training set at the scene root, or novel/.
+struct ViewSetPaths {
+  std::filesystem::path images;  // <name>.png
+  std::filesystem::path sparse;  // COLMAP text model (points3D.txt empty)
+  std::filesystem::path depth;   // <stem>.exr, float32 z-depth, 0 = background
+  std::filesystem::path normal;  // <stem>.exr, optional, camera-frame unit normals
+
+  std::filesystem::path DepthFor(const std::string& image_name) const;
+  std::filesystem::path NormalFor(const std::string& image_name) const;
+};
+
+struct SceneFolder {
+  std::filesystem::path root;
+
+  std::filesystem::path SceneJson() const { return root / "scene.json"; }
+  ViewSetPaths Training() const;
+  ViewSetPaths Novel() const;
+};
+
+}  // namespace parallax
