@@ -45,9 +45,9 @@ int main(int argc, char** argv) {
       "parallax");
   app.require_subcommand(1);
   RegisterSynthCommand(app);
-  RegisterPendingCommand(app, "reconstruct", "Photos folder -> workspace (COLMAP SfM + depth)");
+  RegisterReconstructCommand(app);
   RegisterPendingCommand(app, "render", "Novel views of a workspace or scene folder");
-  RegisterPendingCommand(app, "evaluate", "Measure a workspace against a scene's ground truth");
+  RegisterEvaluateCommand(app);
   RegisterPendingCommand(app, "view", "Shadowed, textured OpenGL viewer and screenshots");
   RegisterPendingCommand(app, "bench", "Error against run time over a grid of settings");
   try {

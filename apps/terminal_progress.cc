@@ -1,6 +1,11 @@
 #include "apps/terminal_progress.h"
 
+#include <unistd.h>
+
 namespace parallax {
+
+TerminalProgress::TerminalProgress(std::FILE* stream)
+    : stream_(stream), interactive_(::isatty(::fileno(stream)) != 0) {}
 
 TerminalProgress::~TerminalProgress() {
   if (line_open_) std::fputc('\n', stream_);
@@ -10,10 +15,21 @@ void TerminalProgress::Update(std::string_view stage, int64_t done, int64_t tota
   const auto now = std::chrono::steady_clock::now();
   if (stage != stage_) {
     if (line_open_) std::fputc('\n', stream_);
+    line_open_ = false;
+    stage_reported_ = false;
     stage_ = stage;
     stage_start_ = now;
   }
   const double elapsed = std::chrono::duration<double>(now - stage_start_).count();
+  if (!interactive_) {
+    // A log file gets one line per finished stage, not a line redrawn in place.
+    if (done == total && !stage_reported_) {
+      std::fprintf(stream_, "%-12s %lld/%lld  %6.1f s\n", stage_.c_str(),
+                   static_cast<long long>(done), static_cast<long long>(total), elapsed);
+      stage_reported_ = true;
+    }
+    return;
+  }
   std::fprintf(stream_, "\r%-12s %lld/%lld  %6.1f s", stage_.c_str(),
                static_cast<long long>(done), static_cast<long long>(total), elapsed);
   if (done > 0 && done < total) {

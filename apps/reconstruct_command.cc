@@ -1,0 +1,116 @@
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include "apps/commands.h"
+#include "apps/terminal_progress.h"
+#include "pipeline/reconstruct.h"
+
+namespace parallax {
+namespace {
+
+std::vector<double> ParseIntrinsics(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  for (std::string item; std::getline(stream, item, ',');) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("--intrinsics '" + text + "': '" + item + "' is not a number");
+    }
+  }
+  return values;
+}
+
+void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path& workspace,
+                  bool dry_run) {
+  std::printf("%s: %d photos; matcher: %s; camera: %s\n", dry_run ? "plan" : "reconstruct",
+              summary.images_found, summary.matcher.c_str(), summary.camera_model.c_str());
+  for (const StageRecord& stage : summary.stages) {
+    if (stage.skipped) {
+      std::printf("  %-12s skipped: %s\n", stage.name.c_str(), stage.reason.c_str());
+    } else if (dry_run) {
+      std::printf("  %-12s will run: %s\n", stage.name.c_str(), stage.reason.c_str());
+    } else {
+      std::printf("  %-12s %7.1f s\n", stage.name.c_str(), stage.seconds);
+    }
+  }
+  if (!dry_run) {
+    std::printf("registered %d/%d photos, %zu 3D points, mean track length %.2f, mean "
+                "reprojection error %.3f px\n",
+                summary.images_registered, summary.images_found, summary.points3d,
+                summary.mean_track_length, summary.mean_reprojection_error_px);
+    std::printf("focal length %.1f px (prior %.1f px), median triangulation angle %.1f deg\n",
+                summary.plausibility.focal_px, summary.plausibility.focal_prior_px,
+                summary.plausibility.median_triangulation_deg);
+  }
+  for (const std::string& warning : summary.warnings) {
+    std::fprintf(stderr, "WARNING: %s\n", warning.c_str());
+  }
+  if (!dry_run) std::printf("workspace: %s (report.json)\n", workspace.string().c_str());
+}
+
+}  // namespace
+
+void RegisterReconstructCommand(CLI::App& app) {
+  struct Arguments {
+    std::filesystem::path photos;
+    std::filesystem::path workspace;
+    std::string intrinsics;
+    std::string camera_model = "SIMPLE_RADIAL";
+    ReconstructOptions options;
+  };
+  auto arguments = std::make_shared<Arguments>();
+  CLI::App* command = app.add_subcommand(
+      "reconstruct",
+      "Photos folder -> workspace: COLMAP features, matching, mapping and undistortion "
+      "(CPU), checked for plausibility. Re-running skips stages whose inputs and options are "
+      "unchanged.");
+  command->add_option("photos_dir", arguments->photos, "folder of photos (not recursive)")
+      ->required();
+  command->add_option("workspace", arguments->workspace, "output folder (created if missing)")
+      ->required();
+  const std::map<std::string, Quality> qualities = {
+      {"fast", Quality::kFast}, {"balanced", Quality::kBalanced}, {"best", Quality::kBest}};
+  command->add_option("--quality", arguments->options.quality,
+                      "fast: images <= 1024 px, 2048 features; balanced (default): <= 2000 px, "
+                      "4096 features; best: <= 3200 px, 8192 features, guided matching")
+      ->transform(CLI::CheckedTransformer(qualities, CLI::ignore_case));
+  const std::map<std::string, MatcherChoice> matchers = {{"auto", MatcherChoice::kAuto},
+                                                         {"exhaustive", MatcherChoice::kExhaustive},
+                                                         {"sequential", MatcherChoice::kSequential}};
+  command->add_option("--matcher", arguments->options.matcher,
+                      "auto (default): exhaustive up to 300 photos, else sequential with the "
+                      "ends matched for loop closure")
+      ->transform(CLI::CheckedTransformer(matchers, CLI::ignore_case));
+  command->add_option("--camera-model", arguments->camera_model,
+                      "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");
+  command->add_option("--intrinsics", arguments->intrinsics,
+                      "known intrinsics held fixed: f (principal point at the centre) or "
+                      "fx,fy,cx,cy, in pixels");
+  command->add_option("--known-cameras", arguments->options.known_cameras,
+                      "COLMAP model folder with known intrinsics and poses: only triangulate")
+      ->check(CLI::ExistingDirectory);
+  command->add_flag("--strict", arguments->options.strict,
+                    "an implausible reconstruction is an error (exit 2), not a warning");
+  command->add_flag("--dry-run", arguments->options.dry_run,
+                    "print the plan (stages to run or skip, and why) and stop");
+  command->add_option("--colmap", arguments->options.colmap,
+                      "colmap executable (default: colmap on PATH)");
+  command->callback([arguments] {
+    ReconstructOptions options = arguments->options;
+    options.camera_model = CameraModelFromName(arguments->camera_model);
+    if (!arguments->intrinsics.empty()) options.intrinsics = ParseIntrinsics(arguments->intrinsics);
+    ReconstructSummary summary;
+    {
+      TerminalProgress progress;
+      summary = Reconstruct(arguments->photos, arguments->workspace, options, progress);
+    }
+    PrintSummary(summary, arguments->workspace, options.dry_run);
+  });
+}
+
+}  // namespace parallax

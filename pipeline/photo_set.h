@@ -1,0 +1,44 @@
+#pragma once
+// The photos `reconstruct` starts from: which files in the folder are usable images, their
+// sizes, EXIF focal lengths and content hashes; and which files were skipped, and why.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace parallax {
+
+struct Photo {
+  std::string name;  // File name inside the folder.
+  int width = 0;
+  int height = 0;
+  std::optional<double> exif_focal_px;  // From the 35 mm-equivalent focal length, if present.
+  uint64_t content_hash = 0;
+};
+
+struct SkippedFile {
+  std::string name;
+  std::string reason;
+};
+
+struct PhotoSet {
+  std::vector<Photo> photos;  // Sorted by name (COLMAP's order).
+  std::vector<SkippedFile> skipped;
+
+  // True when every photo has the same size and the same (or no) EXIF focal length, so one
+  // camera can serve them all.
+  bool SharesOneCamera() const;
+  // The focal length SfM starts from: EXIF when present, else COLMAP's default 1.2 * max(w, h).
+  double FocalPrior(const Photo& photo) const;
+  // Hash of every name and content: changes when any photo changes.
+  uint64_t ContentHash() const;
+};
+
+// Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.
+// Unreadable, corrupt or non-image files are skipped with their reason. Throws BadInputError
+// if the folder does not exist, is not a folder, or holds fewer than 2 readable images (the
+// message lists the skipped files).
+PhotoSet ScanPhotos(const std::filesystem::path& dir);
+
+}  // namespace parallax

@@ -1,0 +1,526 @@
+#include "pipeline/reconstruct.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/hash.h"
+#include "core/sparse_model.h"
+#include "pipeline/colmap.h"
+#include "pipeline/stage_cache.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+struct QualitySettings {
+  int max_image_size;
+  int max_num_features;
+  bool guided_matching;
+};
+
+QualitySettings SettingsFor(Quality quality) {
+  switch (quality) {
+    case Quality::kFast: return {1024, 2048, false};
+    case Quality::kBalanced: return {2000, 4096, false};
+    case Quality::kBest: return {3200, 8192, true};
+  }
+  throw std::invalid_argument("unknown quality");
+}
+
+// Where each stage keeps its files inside the workspace.
+struct WorkspacePaths {
+  fs::path root;
+  fs::path Sfm() const { return root / "sfm"; }
+  fs::path Database() const { return Sfm() / "database.db"; }
+  fs::path ImageList() const { return Sfm() / "image_list.txt"; }
+  fs::path KnownModel() const { return Sfm() / "known"; }
+  fs::path Models() const { return Sfm() / "models"; }
+  fs::path RawModel() const { return Sfm() / "sparse"; }
+  fs::path Logs() const { return root / "logs"; }
+  fs::path Log(const std::string& stage) const { return Logs() / (stage + ".log"); }
+  fs::path Sparse() const { return root / "sparse"; }
+  fs::path Images() const { return root / "images"; }
+  fs::path Report() const { return root / "report.json"; }
+  fs::path Stages() const { return root / "stages.json"; }
+};
+
+std::string Join(const std::vector<double>& values) {
+  std::ostringstream text;
+  text.precision(17);
+  for (size_t i = 0; i < values.size(); ++i) text << (i ? "," : "") << values[i];
+  return text.str();
+}
+
+// Names and contents of the files in `dir`, in name order.
+uint64_t HashFolder(const fs::path& dir) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.is_regular_file()) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  Hasher hasher;
+  for (const fs::path& file : files) hasher.Add(file.filename().string()).Add(ReadFileBytes(file));
+  return hasher.Value();
+}
+
+void CheckWorkspaceWritable(const fs::path& workspace) {
+  std::error_code error;
+  fs::create_directories(workspace, error);
+  if (error || !fs::is_directory(workspace)) {
+    throw BadInputError("workspace " + workspace.string() + " cannot be created: " +
+                        (error ? error.message() : "not a folder"));
+  }
+  const fs::path probe = workspace / ".parallax_write_test";
+  try {
+    WriteFileAtomically(probe, "ok");
+  } catch (const BadInputError&) {
+    throw BadInputError("workspace " + workspace.string() + " is not writable");
+  }
+  fs::remove(probe, error);
+}
+
+// Removes a folder left by an interrupted stage, or the previous result a stage replaces.
+void RemoveAll(const fs::path& path) {
+  std::error_code error;
+  fs::remove_all(path, error);
+  if (error) throw BadInputError("cannot remove " + path.string() + ": " + error.message());
+}
+
+// Moves `from` to `to`, replacing what was there (directory rename is atomic).
+void Replace(const fs::path& from, const fs::path& to) {
+  RemoveAll(to);
+  fs::rename(from, to);
+}
+
+// The COLMAP image model the extractor starts from, and its parameters when they are fixed.
+struct CameraSetup {
+  CameraModel model;
+  std::string params;  // Empty: COLMAP estimates them, from EXIF or the image size.
+  bool single_camera;
+  bool fixed_intrinsics;
+};
+
+CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
+                              const SparseModel* known) {
+  const bool shared = photos.SharesOneCamera();
+  if (known) {
+    const bool single = known->Cameras().size() == 1;
+    const Camera& first = known->Cameras().front();
+    return {single ? first.model : options.camera_model, single ? Join(first.params) : "",
+            single, true};
+  }
+  if (options.intrinsics.empty()) return {options.camera_model, "", shared, false};
+  if (!shared && options.intrinsics.size() == 1) {
+    throw BadInputError("--intrinsics f needs photos of one size (the principal point is put at "
+                        "the image centre); give fx,fy,cx,cy or photos of one size");
+  }
+  const Photo& photo = photos.photos.front();
+  if (options.intrinsics.size() == 1) {
+    return {CameraModel::kSimplePinhole,
+            Join({options.intrinsics[0], photo.width / 2.0, photo.height / 2.0}), true, true};
+  }
+  return {CameraModel::kPinhole, Join(options.intrinsics), true, true};
+}
+
+// The known model rewritten with the ids COLMAP's database gives the photos: images 1..N in
+// name order; one camera (id 1) when shared, else camera i for image i.
+SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& photos,
+                                      const fs::path& known_dir) {
+  SparseModel aligned;
+  const bool single = known.Cameras().size() == 1;
+  if (single) {
+    Camera camera = known.Cameras().front();
+    camera.id = 1;
+    aligned.AddCamera(camera);
+  }
+  for (size_t i = 0; i < photos.photos.size(); ++i) {
+    const SparseImage* image = known.FindImageByName(photos.photos[i].name);
+    if (!image) {
+      throw BadInputError("--known-cameras " + known_dir.string() + " has no image named " +
+                          photos.photos[i].name);
+    }
+    SparseImage copy = *image;
+    copy.id = static_cast<uint32_t>(i + 1);
+    copy.points2d.clear();
+    if (!single) {
+      Camera camera = known.CameraById(image->camera_id);
+      camera.id = copy.id;
+      aligned.AddCamera(camera);
+    }
+    copy.camera_id = single ? 1 : copy.id;
+    aligned.AddImage(std::move(copy));
+  }
+  return aligned;
+}
+
+class StageRunner {
+ public:
+  StageRunner(const WorkspacePaths& paths, bool dry_run, ReconstructSummary& summary)
+      : cache_(paths.Stages()), dry_run_(dry_run), summary_(summary) {}
+
+  // Runs `body` unless the stage completed before with the same key and its output exists.
+  void Run(const std::string& name, const std::string& key, const fs::path& output,
+           const std::function<void()>& body) {
+    StageRecord record{name, false, "", 0};
+    if (cache_.IsDone(name, key) && fs::exists(output)) {
+      record.skipped = true;
+      record.reason = "inputs and options unchanged since the last run";
+    } else if (dry_run_) {
+      record.reason = fs::exists(output) ? "inputs or options changed" : "not run yet";
+    } else {
+      const auto start = std::chrono::steady_clock::now();
+      body();
+      record.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      cache_.MarkDone(name, key);
+    }
+    summary_.stages.push_back(record);
+  }
+
+ private:
+  StageCache cache_;
+  bool dry_run_;
+  ReconstructSummary& summary_;
+};
+
+SparseModel LargestModel(const fs::path& models_dir, int& other_models) {
+  std::vector<fs::path> dirs;
+  for (const auto& entry : fs::directory_iterator(models_dir)) {
+    if (entry.is_directory() && DetectSparseFormat(entry.path())) dirs.push_back(entry.path());
+  }
+  if (dirs.empty()) {
+    throw BadInputError("COLMAP could not reconstruct these photos (no image pair with "
+                        "enough matches to start from); see " +
+                        (models_dir.parent_path().parent_path() / "logs" / "mapper.log").string());
+  }
+  std::sort(dirs.begin(), dirs.end());
+  SparseModel best;
+  for (const fs::path& dir : dirs) {
+    SparseModel model = ReadSparseModel(dir);
+    if (model.Images().size() > best.Images().size()) best = std::move(model);
+  }
+  other_models = static_cast<int>(dirs.size()) - 1;
+  return best;
+}
+
+void FillModelStatistics(const SparseModel& model, const PhotoSet& photos,
+                         ReconstructSummary& summary) {
+  summary.images_registered = static_cast<int>(model.Images().size());
+  summary.points3d = model.Points3D().size();
+  double track_sum = 0, error_sum = 0;
+  for (const Point3D& point : model.Points3D()) {
+    track_sum += static_cast<double>(point.track.size());
+    error_sum += std::max(0.0, point.error);
+  }
+  const double n = std::max<double>(1, static_cast<double>(model.Points3D().size()));
+  summary.mean_track_length = track_sum / n;
+  summary.mean_reprojection_error_px = error_sum / n;
+  summary.unregistered.clear();
+  for (const Photo& photo : photos.photos) {
+    if (!model.FindImageByName(photo.name)) summary.unregistered.push_back(photo.name);
+  }
+}
+
+nlohmann::json ReportJson(const ReconstructSummary& summary) {
+  nlohmann::json stages = nlohmann::json::array(), timings = nlohmann::json::object();
+  for (const StageRecord& stage : summary.stages) {
+    stages.push_back({{"name", stage.name}, {"skipped", stage.skipped},
+                      {"reason", stage.reason}, {"seconds", stage.seconds}});
+    timings[stage.name] = stage.seconds;
+  }
+  nlohmann::json skipped_files = nlohmann::json::array();
+  for (const SkippedFile& file : summary.skipped_files) {
+    skipped_files.push_back({{"name", file.name}, {"reason", file.reason}});
+  }
+  const PlausibilityReport& plausibility = summary.plausibility;
+  return {{"images_found", summary.images_found},
+          {"images_registered", summary.images_registered},
+          {"unregistered", summary.unregistered},
+          {"other_models", summary.other_models},
+          {"points3d", summary.points3d},
+          {"mean_track_length", summary.mean_track_length},
+          {"mean_reprojection_error_px", summary.mean_reprojection_error_px},
+          {"matcher", summary.matcher},
+          {"camera_model", summary.camera_model},
+          {"skipped_files", skipped_files},
+          {"stages", stages},
+          {"timings_s", timings},
+          {"plausibility",
+           {{"plausible", plausibility.Plausible()},
+            {"focal_px", plausibility.focal_px},
+            {"focal_prior_px", plausibility.focal_prior_px},
+            {"prior_from_exif", plausibility.prior_from_exif},
+            {"median_triangulation_deg", plausibility.median_triangulation_deg},
+            {"well_constrained_image_share", plausibility.well_constrained_image_share},
+            {"problems", plausibility.problems}}},
+          {"warnings", summary.warnings}};
+}
+
+// Keeps what later stages wrote into report.json; replaces the "reconstruct" section.
+void WriteReport(const fs::path& path, const ReconstructSummary& summary) {
+  nlohmann::json report = nlohmann::json::object();
+  if (fs::exists(path)) {
+    try {
+      report = nlohmann::json::parse(ReadFileBytes(path));
+    } catch (const std::exception&) {
+      report = nlohmann::json::object();
+    }
+    if (!report.is_object()) report = nlohmann::json::object();
+  }
+  report["reconstruct"] = ReportJson(summary);
+  WriteFileAtomically(path, report.dump(2) + "\n");
+}
+
+}  // namespace
+
+void ReconstructOptions::Check() const {
+  if (!intrinsics.empty() && intrinsics.size() != 1 && intrinsics.size() != 4) {
+    throw std::invalid_argument("intrinsics must be f or fx,fy,cx,cy");
+  }
+  for (const double value : intrinsics) {
+    if (!(value > 0) || !std::isfinite(value)) {
+      throw std::invalid_argument("intrinsics must be positive numbers");
+    }
+  }
+  if (!intrinsics.empty() && !known_cameras.empty()) {
+    throw std::invalid_argument("intrinsics and known_cameras exclude each other");
+  }
+  if (!IsProjectionSupported(camera_model)) {
+    throw std::invalid_argument("camera_model " + std::string(CameraModelName(camera_model)) +
+                                " is not supported");
+  }
+  if (exhaustive_limit < 2) throw std::invalid_argument("exhaustive_limit must be >= 2");
+  if (sequential_overlap < 1) throw std::invalid_argument("sequential_overlap must be >= 1");
+  plausibility.Check();
+}
+
+ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& workspace,
+                               const ReconstructOptions& options, Progress& progress) {
+  options.Check();
+  // Everything that can be checked is checked before colmap starts.
+  const Colmap colmap(options.colmap);
+  const PhotoSet photos = ScanPhotos(photos_dir);
+  std::optional<SparseModel> known;
+  if (!options.known_cameras.empty()) known = ReadSparseModel(options.known_cameras);
+  if (!options.dry_run) CheckWorkspaceWritable(workspace);
+
+  const WorkspacePaths paths{workspace};
+  ReconstructSummary summary;
+  summary.images_found = static_cast<int>(photos.photos.size());
+  summary.skipped_files = photos.skipped;
+  for (const SkippedFile& file : photos.skipped) {
+    summary.warnings.push_back("skipped " + file.name + ": it " + file.reason);
+  }
+  const CameraSetup camera = ChooseCameraSetup(photos, options, known ? &*known : nullptr);
+  summary.camera_model = std::string(CameraModelName(camera.model)) +
+                         (camera.single_camera ? ", one shared camera" : ", one camera per image") +
+                         (camera.fixed_intrinsics ? ", intrinsics fixed" : "");
+  const int num_images = static_cast<int>(photos.photos.size());
+  const bool sequential =
+      options.matcher == MatcherChoice::kSequential ||
+      (options.matcher == MatcherChoice::kAuto && num_images > options.exhaustive_limit);
+  summary.matcher =
+      sequential ? "sequential (overlap " + std::to_string(options.sequential_overlap) +
+                       ", first and last images matched for loop closure)"
+                 : "exhaustive (" + std::to_string(num_images) + " images, every pair)";
+  if (options.matcher == MatcherChoice::kAuto) summary.matcher += ", chosen automatically";
+  const QualitySettings quality = SettingsFor(options.quality);
+  StageRunner stages(paths, options.dry_run, summary);
+
+  // Features.
+  const std::string features_key =
+      Hasher()
+          .Add(photos.ContentHash())
+          .Add(CameraModelName(camera.model))
+          .Add(camera.params)
+          .Add(camera.single_camera)
+          .Add(static_cast<uint64_t>(quality.max_image_size))
+          .Add(static_cast<uint64_t>(quality.max_num_features))
+          .Hex();
+  stages.Run("features", features_key, paths.Database(), [&] {
+    fs::create_directories(paths.Sfm());
+    std::string list;
+    for (const Photo& photo : photos.photos) list += photo.name + "\n";
+    WriteFileAtomically(paths.ImageList(), list);
+    const fs::path database = paths.Database().string() + ".tmp";
+    RemoveAll(database);
+    std::vector<std::string> arguments = {
+        "--database_path", database.string(), "--image_path", photos_dir.string(),
+        "--image_list_path", paths.ImageList().string(),
+        "--ImageReader.camera_model", std::string(CameraModelName(camera.model)),
+        "--ImageReader.single_camera", camera.single_camera ? "1" : "0",
+        "--SiftExtraction.use_gpu", "0",
+        "--SiftExtraction.max_image_size", std::to_string(quality.max_image_size),
+        "--SiftExtraction.max_num_features", std::to_string(quality.max_num_features)};
+    if (!camera.params.empty()) {
+      arguments.insert(arguments.end(), {"--ImageReader.camera_params", camera.params});
+    }
+    colmap.Run("feature_extractor", arguments, paths.Log("features"), "features", num_images,
+               progress);
+    fs::rename(database, paths.Database());
+  });
+
+  // Matches.
+  const std::string matches_key = Hasher()
+                                      .Add(features_key)
+                                      .Add(sequential)
+                                      .Add(static_cast<uint64_t>(options.sequential_overlap))
+                                      .Add(quality.guided_matching)
+                                      .Hex();
+  const fs::path matched_marker = paths.Sfm() / "matched";
+  stages.Run("matches", matches_key, matched_marker, [&] {
+    const fs::path database = paths.Database().string() + ".tmp";
+    fs::copy_file(paths.Database(), database, fs::copy_options::overwrite_existing);
+    const std::vector<std::string> common = {
+        "--database_path", database.string(), "--SiftMatching.use_gpu", "0",
+        "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"};
+    if (sequential) {
+      std::vector<std::string> arguments = common;
+      arguments.insert(arguments.end(),
+                       {"--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
+                        "--SequentialMatching.loop_detection", "0"});
+      colmap.Run("sequential_matcher", arguments, paths.Log("matches"), "matches", num_images,
+                 progress);
+      // Without a vocabulary tree, a ring closes only if its ends are matched explicitly.
+      std::string pairs;
+      const int ends = std::min(options.sequential_overlap / 2 + 1, num_images / 2);
+      for (int i = 0; i < ends; ++i) {
+        for (int j = num_images - ends; j < num_images; ++j) {
+          pairs += photos.photos[static_cast<size_t>(i)].name + " " +
+                   photos.photos[static_cast<size_t>(j)].name + "\n";
+        }
+      }
+      const fs::path pairs_path = paths.Sfm() / "loop_pairs.txt";
+      WriteFileAtomically(pairs_path, pairs);
+      arguments = common;
+      arguments.insert(arguments.end(), {"--match_list_path", pairs_path.string(),
+                                         "--match_type", "pairs"});
+      colmap.Run("matches_importer", arguments, paths.Log("matches"), "loop closure",
+                 num_images, progress);
+    } else {
+      colmap.Run("exhaustive_matcher", common, paths.Log("matches"), "matches", num_images,
+                 progress);
+    }
+    fs::rename(database, paths.Database());
+    WriteFileAtomically(matched_marker, matches_key);
+  });
+
+  // Mapping, or triangulation from known cameras.
+  const std::string mapper_key =
+      Hasher()
+          .Add(matches_key)
+          .Add(camera.fixed_intrinsics)
+          .Add(known ? HashFolder(options.known_cameras) : 0)
+          .Hex();
+  const std::string mapper_stage = known ? "triangulate" : "mapper";
+  stages.Run(mapper_stage, mapper_key, paths.RawModel(), [&] {
+    const fs::path models = paths.Models().string() + ".tmp";
+    RemoveAll(models);
+    fs::create_directories(models);
+    const std::vector<std::string> common = {"--database_path", paths.Database().string(),
+                                             "--image_path", photos_dir.string()};
+    if (known) {
+      WriteSparseModel(AlignKnownModelToDatabase(*known, photos, options.known_cameras),
+                       paths.KnownModel(), SparseFormat::kBinary);
+      fs::create_directories(models / "0");
+      std::vector<std::string> arguments = common;
+      arguments.insert(arguments.end(),
+                       {"--input_path", paths.KnownModel().string(), "--output_path",
+                        (models / "0").string(), "--Mapper.ba_refine_focal_length", "0",
+                        "--Mapper.ba_refine_principal_point", "0",
+                        "--Mapper.ba_refine_extra_params", "0"});
+      colmap.Run("point_triangulator", arguments, paths.Log(mapper_stage), mapper_stage,
+                 num_images, progress);
+    } else {
+      std::vector<std::string> arguments = common;
+      arguments.insert(arguments.end(), {"--output_path", models.string(),
+                                         "--image_list_path", paths.ImageList().string()});
+      if (camera.fixed_intrinsics) {
+        arguments.insert(arguments.end(), {"--Mapper.ba_refine_focal_length", "0",
+                                           "--Mapper.ba_refine_principal_point", "0",
+                                           "--Mapper.ba_refine_extra_params", "0"});
+      }
+      colmap.Run("mapper", arguments, paths.Log(mapper_stage), mapper_stage, num_images,
+                 progress);
+    }
+    Replace(models, paths.Models());
+    int other_models = 0;
+    WriteSparseModel(LargestModel(paths.Models(), other_models), paths.RawModel(),
+                     SparseFormat::kBinary);
+  });
+
+  const std::string undistort_key = Hasher().Add(mapper_key).Hex();
+  if (options.dry_run) {
+    stages.Run("undistort", undistort_key, paths.Sparse(), [] {});
+    return summary;
+  }
+
+  const SparseModel raw_model = ReadSparseModel(paths.RawModel());
+  LargestModel(paths.Models(), summary.other_models);
+  if (summary.other_models > 0) {
+    summary.warnings.push_back(
+        "COLMAP split the photos into " + std::to_string(summary.other_models + 1) +
+        " disconnected models; kept the largest (" + std::to_string(raw_model.Images().size()) +
+        " images), the others are in " + paths.Models().string());
+  }
+  FillModelStatistics(raw_model, photos, summary);
+  const int required = std::max(2, (num_images + 1) / 2);
+  if (summary.images_registered < required) {
+    std::string names;
+    for (const std::string& name : summary.unregistered) names += " " + name;
+    throw BadInputError("only " + std::to_string(summary.images_registered) + " of " +
+                        std::to_string(num_images) + " photos were registered (need " +
+                        std::to_string(required) + "); not registered:" + names);
+  }
+  if (!summary.unregistered.empty()) {
+    std::string names;
+    for (const std::string& name : summary.unregistered) names += " " + name;
+    summary.warnings.push_back(std::to_string(summary.unregistered.size()) +
+                               " photos were not registered:" + names);
+  }
+  const Photo& first = photos.photos.front();
+  summary.plausibility =
+      CheckPlausibility(raw_model, photos.FocalPrior(first), first.exif_focal_px.has_value(),
+                        options.plausibility);
+  if (known || camera.fixed_intrinsics) {
+    // The focal length was given, not estimated: only the geometry checks apply.
+    std::erase_if(summary.plausibility.problems,
+                  [](const std::string& problem) { return problem.starts_with("estimated focal"); });
+  }
+  for (const std::string& problem : summary.plausibility.problems) {
+    summary.warnings.push_back("implausible reconstruction: " + problem);
+  }
+  if (options.strict && !summary.plausibility.Plausible()) {
+    WriteReport(paths.Report(), summary);
+    throw BadInputError("implausible reconstruction (--strict): " +
+                        summary.plausibility.problems.front() + "; see " +
+                        paths.Report().string());
+  }
+
+  // Undistortion into the workspace layout (PINHOLE images and model).
+  stages.Run("undistort", undistort_key, paths.Sparse(), [&] {
+    const fs::path output = workspace / ".undistort.tmp";
+    RemoveAll(output);
+    colmap.Run("image_undistorter",
+               {"--image_path", photos_dir.string(), "--input_path", paths.RawModel().string(),
+                "--output_path", output.string(), "--output_type", "COLMAP"},
+               paths.Log("undistort"), "undistort", num_images, progress);
+    Replace(output / "images", paths.Images());
+    Replace(output / "stereo", workspace / "stereo");
+    Replace(output / "sparse", paths.Sparse());
+    RemoveAll(output);
+  });
+  const SparseModel model = ReadSparseModel(paths.Sparse());
+  FillModelStatistics(model, photos, summary);
+  WriteReport(paths.Report(), summary);
+  return summary;
+}
+
+}  // namespace parallax

@@ -1,0 +1,82 @@
+#pragma once
+// `parallax reconstruct`, structure-from-motion part: photos -> COLMAP features, matches,
+// mapping (or triangulation with known cameras) -> undistorted PINHOLE workspace
+// (DESIGN.md "Workspace"), with a plausibility check and <ws>/report.json.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/camera.h"
+#include "core/progress.h"
+#include "pipeline/photo_set.h"
+#include "pipeline/plausibility.h"
+
+namespace parallax {
+
+enum class Quality {
+  kFast,      // Images up to 1024 px, 2048 features: a quick look.
+  kBalanced,  // Images up to 2000 px, 4096 features: the default.
+  kBest,      // Images up to 3200 px, 8192 features, guided matching (COLMAP's defaults+).
+};
+
+enum class MatcherChoice {
+  kAuto,        // Exhaustive up to `exhaustive_limit` images, else sequential.
+  kExhaustive,  // Every pair.
+  kSequential,  // Neighbours in name order, plus the ends of the sequence (loop closure).
+};
+
+struct ReconstructOptions {
+  Quality quality = Quality::kBalanced;
+  MatcherChoice matcher = MatcherChoice::kAuto;
+  // Single-focal by default: free fx/fy drift on rings of cameras (DESIGN.md pitfalls).
+  CameraModel camera_model = CameraModel::kSimpleRadial;
+  // Known intrinsics, held fixed in bundle adjustment: {f} (principal point at the image
+  // centre) or {fx, fy, cx, cy}. Empty: estimated.
+  std::vector<double> intrinsics;
+  // A COLMAP model whose intrinsics and poses are used as they are (SfM only triangulates).
+  std::filesystem::path known_cameras;
+  // An implausible reconstruction is an error (exit 2) instead of a warning.
+  bool strict = false;
+  // Plan only: say which stages would run or be skipped, and why.
+  bool dry_run = false;
+  // colmap executable (name on PATH or path).
+  std::string colmap = "colmap";
+  // Above this many images the automatic matcher is sequential.
+  int exhaustive_limit = 300;
+  // Neighbours matched on each side by the sequential matcher.
+  int sequential_overlap = 20;
+  PlausibilityOptions plausibility;
+  void Check() const;  // Throws std::invalid_argument naming the field.
+};
+
+struct StageRecord {
+  std::string name;
+  bool skipped = false;
+  std::string reason;  // Why it was skipped (or will run, in a dry run).
+  double seconds = 0;
+};
+
+struct ReconstructSummary {
+  std::vector<StageRecord> stages;
+  std::vector<SkippedFile> skipped_files;
+  std::string matcher;  // The matcher used, and why.
+  std::string camera_model;
+  int images_found = 0;
+  int images_registered = 0;
+  std::vector<std::string> unregistered;  // Names of photos not in the model.
+  int other_models = 0;                   // Disconnected models besides the one kept.
+  size_t points3d = 0;
+  double mean_track_length = 0;
+  double mean_reprojection_error_px = 0;
+  PlausibilityReport plausibility;
+  std::vector<std::string> warnings;
+};
+
+// Runs (or with dry_run, plans) the SfM stages into `workspace`. Validates everything before
+// starting colmap. Throws BadInputError (bad photos, unwritable workspace, too few images
+// registered, implausible under strict), ToolError (colmap missing or failing).
+ReconstructSummary Reconstruct(const std::filesystem::path& photos_dir,
+                               const std::filesystem::path& workspace,
+                               const ReconstructOptions& options, Progress& progress);
+
+}  // namespace parallax

@@ -1,0 +1,26 @@
+#pragma once
+// Which stages of a workspace are complete, and for which inputs: each stage records the key
+// (a hash of its inputs and options) it last completed with, in <ws>/stages.json. A stage
+// whose key is unchanged and whose outputs exist is skipped; an interrupted stage never
+// recorded its key, so it runs again.
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace parallax {
+
+class StageCache {
+ public:
+  // Loads `file` if it exists; an unreadable or corrupt file counts as "nothing done".
+  explicit StageCache(std::filesystem::path file);
+
+  bool IsDone(const std::string& stage, const std::string& key) const;
+  // Records the stage as complete and writes the file atomically.
+  void MarkDone(const std::string& stage, const std::string& key);
+
+ private:
+  std::filesystem::path file_;
+  std::map<std::string, std::string> keys_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,119 @@
+// Every error path of `parallax reconstruct`, through the real executable: exit code and
+// message. Input is validated before colmap starts, so these run in well under a second each.
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/image.h"
+#include "tests/cli_runner.h"
+#include "tests/temp_dir.h"
+
+namespace parallax {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
+
+void ExpectFailure(const CliResult& result, int exit_code, const std::string& expected) {
+  EXPECT_EQ(result.exit_code, exit_code) << result.output;
+  EXPECT_NE(result.output.find(expected), std::string::npos)
+      << "expected '" << expected << "' in:\n" << result.output;
+}
+
+std::string Reconstruct(const fs::path& photos, const fs::path& workspace,
+                        const std::string& flags = "") {
+  return "reconstruct " + Quote(photos.string()) + " " + Quote(workspace.string()) + " " + flags;
+}
+
+TEST(ReconstructCli, ColmapMissingExitsThreeAndSaysHowToInstall) {
+  const TempDir dir;
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--colmap /no/colmap")),
+                3, "apt-get install colmap");
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws"), "PATH=/nonexistent"),
+                3, "colmap not found");
+}
+
+TEST(ReconstructCli, MissingOrEmptyFolderExitsTwo) {
+  const TempDir dir;
+  ExpectFailure(RunParallax(Reconstruct(dir.Path() / "missing", dir.Path() / "ws")), 2,
+                "does not exist");
+  fs::create_directories(dir.Path() / "empty");
+  ExpectFailure(RunParallax(Reconstruct(dir.Path() / "empty", dir.Path() / "ws")), 2, "is empty");
+}
+
+TEST(ReconstructCli, FewerThanTwoReadableImagesExitsTwoListingTheRest) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos with spaces";
+  fs::create_directories(photos);
+  fs::copy_file(kSmallImages / "0000.png", photos / "0000.png");
+  std::ofstream(photos / "notes.jpg") << "this is text";
+  std::ofstream(photos / "zero.png");
+  ExpectFailure(RunParallax(Reconstruct(photos, dir.Path() / "ws")), 2, "1 readable image");
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws"));
+  EXPECT_NE(result.output.find("notes.jpg is not an image"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("zero.png is empty"), std::string::npos) << result.output;
+}
+
+TEST(ReconstructCli, UnreadableFilesAreSkippedWithAWarningWhenEnoughImagesRemain) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  for (const char* name : {"0000.png", "0001.png", "0002.png"}) {
+    fs::copy_file(kSmallImages / name, photos / name);
+  }
+  std::ofstream(photos / "readme.txt") << "not a photo";
+  const std::string png = [] {
+    std::ifstream file(kSmallImages / "0003.png", std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(file), {});
+  }();
+  std::ofstream(photos / "truncated.png", std::ios::binary).write(png.data(), 2000);
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws", "--dry-run"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("plan: 3 photos"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("skipped readme.txt"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("skipped truncated.png: it is corrupt or truncated"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("features     will run"), std::string::npos) << result.output;
+}
+
+TEST(ReconstructCli, UnwritableWorkspaceExitsTwo) {
+  const TempDir dir;
+  std::ofstream(dir.Path() / "a_file") << "x";
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "a_file" / "ws")), 2,
+                "cannot be created");
+}
+
+TEST(ReconstructCli, BadIntrinsicsAndModelsAreUsageErrors) {
+  const TempDir dir;
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--intrinsics 1,2")), 1,
+                "intrinsics must be f or fx,fy,cx,cy");
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--intrinsics abc")), 1,
+                "'abc' is not a number");
+  ExpectFailure(
+      RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--camera-model FISHEYE9")), 1,
+      "unknown camera model 'FISHEYE9'");
+}
+
+TEST(ReconstructCli, ColmapFailingExitsThreeWithItsStatusLastLinesAndLog) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  // Two unrelated pictures: nothing to match.
+  fs::copy_file(kSmallImages / "0000.png", photos / "a.png");
+  Image noise(320, 240, 3);
+  uint32_t state = 12345;
+  for (float& value : noise.Pixels()) {
+    state = state * 1664525u + 1013904223u;
+    value = static_cast<float>(state >> 24) / 255.0f;
+  }
+  WriteImage(photos / "b.png", noise, PixelFormat::kUint8);
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws"));
+  ExpectFailure(result, 3, "colmap mapper failed with exit status");
+  EXPECT_NE(result.output.find("  | "), std::string::npos) << result.output;  // Log lines.
+  EXPECT_NE(result.output.find("mapper.log"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace parallax

@@ -1,0 +1,97 @@
+// End to end through the real colmap on example_images/small.
+#include "pipeline/reconstruct.h"
+
+#include <chrono>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/scene_folder.h"
+#include "core/sparse_model.h"
+#include "pipeline/colmap.h"
+#include "pipeline/evaluate.h"
+#include "tests/temp_dir.h"
+
+namespace parallax {
+namespace {
+
+const std::filesystem::path kSmall =
+    std::filesystem::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+
+TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
+  const TempDir workspace;
+  SilentProgress progress;
+  const ReconstructSummary summary =
+      Reconstruct(kSmall / "images", workspace.Path(), {}, progress);
+  EXPECT_EQ(summary.images_found, 12);
+  EXPECT_EQ(summary.images_registered, 12);
+  EXPECT_GT(summary.points3d, 300u);
+  EXPECT_LT(summary.mean_reprojection_error_px, 1.0);
+  EXPECT_TRUE(summary.plausibility.Plausible());
+  // The workspace layout of DESIGN.md: an undistorted PINHOLE model and its images.
+  const SparseModel model = ReadSparseModel(workspace.Path() / "sparse");
+  EXPECT_EQ(model.Cameras().front().model, CameraModel::kPinhole);
+  EXPECT_TRUE(std::filesystem::exists(workspace.Path() / "images" / "0000.png"));
+  EXPECT_TRUE(std::filesystem::exists(workspace.Path() / "report.json"));
+  EXPECT_TRUE(std::filesystem::exists(workspace.Path() / "logs" / "mapper.log"));
+
+  const PoseEvaluation evaluation =
+      EvaluatePoses(model, ReadSparseModel(SceneFolder{kSmall}.Training().sparse));
+  EXPECT_EQ(evaluation.registered, 12);
+  EXPECT_LT(evaluation.rotation_error_mean_deg, 0.5);
+  EXPECT_LT(evaluation.center_error_rel_mean, 0.02);
+  EXPECT_EQ(evaluation.alignment.inliers, 12);
+
+  // A second identical run skips every stage.
+  const ReconstructSummary again = Reconstruct(kSmall / "images", workspace.Path(), {}, progress);
+  for (const StageRecord& stage : again.stages) EXPECT_TRUE(stage.skipped) << stage.name;
+  EXPECT_EQ(again.images_registered, 12);
+}
+
+TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
+  const TempDir workspace;
+  SilentProgress progress;
+  ReconstructOptions options;
+  options.known_cameras = SceneFolder{kSmall}.Training().sparse;
+  const ReconstructSummary summary =
+      Reconstruct(kSmall / "images", workspace.Path(), options, progress);
+  EXPECT_EQ(summary.images_registered, 12);
+  EXPECT_GT(summary.points3d, 300u);
+  const SparseModel truth = ReadSparseModel(options.known_cameras);
+  const SparseModel model = ReadSparseModel(workspace.Path() / "sparse");
+  for (const SparseImage& image : truth.Images()) {
+    const SparseImage* found = model.FindImageByName(image.name);
+    ASSERT_NE(found, nullptr) << image.name;
+    EXPECT_LT(RotationAngleDeg(found->cam_from_world.rotation, image.cam_from_world.rotation), 1e-9);
+    EXPECT_LT((CameraCenter(found->cam_from_world) - CameraCenter(image.cam_from_world)).norm(), 1e-9);
+  }
+  EXPECT_DOUBLE_EQ(model.Cameras().front().FocalX(), truth.Cameras().front().FocalX());
+}
+
+TEST(Colmap, AFailingCommandNamesTheToolStatusAndLog) {
+  const TempDir dir;
+  SilentProgress progress;
+  const Colmap colmap;
+  try {
+    colmap.Run("no_such_command", {}, dir.Path() / "logs" / "x.log", "x", 0, progress);
+    FAIL() << "no error";
+  } catch (const ToolError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("colmap no_such_command failed with exit status"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("x.log"), std::string::npos) << message;
+  }
+}
+
+TEST(Colmap, ProgressLinesAreParsed) {
+  EXPECT_EQ(ParseColmapProgress("Processed file [3/12]", 0).done, 3);
+  EXPECT_EQ(ParseColmapProgress("Matching block [2/3, 1/3] in 1.2s", 0).done, 4);
+  EXPECT_EQ(ParseColmapProgress("Matching block [2/3, 1/3] in 1.2s", 0).total, 9);
+  EXPECT_EQ(ParseColmapProgress("Registering image #7 (5)", 12).done, 5);
+  EXPECT_EQ(ParseColmapProgress("Registering image #7 (5)", 12).total, 12);
+  EXPECT_EQ(ParseColmapProgress("Undistorting image [4/9]", 0).total, 9);
+  EXPECT_EQ(ParseColmapProgress("Bundle adjustment report", 0).done, -1);
+}
+
+}  // namespace
+}  // namespace parallax
