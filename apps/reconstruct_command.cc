@@ -47,6 +47,7 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
                 summary.plausibility.focal_px, summary.plausibility.focal_prior_px,
                 summary.plausibility.median_triangulation_deg);
   }
+  for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
   for (const std::string& warning : summary.warnings) {
     std::fprintf(stderr, "WARNING: %s\n", warning.c_str());
   }

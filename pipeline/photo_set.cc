@@ -47,7 +47,8 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
 
 bool PhotoSet::SharesOneCamera() const {
   return std::all_of(photos.begin(), photos.end(), [&](const Photo& photo) {
-    return photo.width == photos.front().width && photo.height == photos.front().height &&
+    return photo.width == photos.front().width &&
+           photo.height == photos.front().height &&
            photo.exif_focal_px == photos.front().exif_focal_px;
   });
 }

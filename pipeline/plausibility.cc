@@ -40,6 +40,9 @@ void PlausibilityOptions::Check() const {
     throw std::invalid_argument("min_focal_ratio_default must be in (0, 1)");
   }
   if (!(well_triangulated_deg > 0)) throw std::invalid_argument("well_triangulated_deg must be > 0");
+  if (!(max_principal_point_offset > 0)) {
+    throw std::invalid_argument("max_principal_point_offset must be > 0");
+  }
   if (min_points_per_image < 1) throw std::invalid_argument("min_points_per_image must be >= 1");
 }
 
@@ -87,6 +90,16 @@ PlausibilityReport CheckPlausibility(const SparseModel& model, double focal_prio
     report.problems.push_back(Format(
         "estimated focal length %.1f px is %.2fx its prior %.1f px", report.focal_px, ratio,
         focal_prior_px) + (prior_from_exif ? " (from EXIF)" : " (from the image size)"));
+  }
+
+  for (const Camera& camera : model.Cameras()) {
+    const double dx = std::abs(camera.PrincipalX() / static_cast<double>(camera.width) - 0.5);
+    const double dy = std::abs(camera.PrincipalY() / static_cast<double>(camera.height) - 0.5);
+    if (std::max(dx, dy) > options.max_principal_point_offset) {
+      report.problems.push_back(Format(
+          "camera %u: principal point (%.1f, %.1f) is %.0f%% of the image size off-centre",
+          camera.id, camera.PrincipalX(), camera.PrincipalY(), 100 * std::max(dx, dy)));
+    }
   }
 
   const std::vector<double> angles = TriangulationAnglesDeg(model);

@@ -22,6 +22,8 @@ struct PlausibilityOptions {
   double well_triangulated_deg = 2.0;
   // Below this median triangulation angle (degrees) depth and focal length are ill-determined.
   double min_median_triangulation_deg = 2.0;
+  // The principal point may lie at most this fraction of the image size from its centre.
+  double max_principal_point_offset = 0.1;
   // An image is well constrained with at least this many well-triangulated points ...
   int min_points_per_image = 30;
   // ... and at least this share of registered images must be.
