@@ -13,6 +13,7 @@
 #include "core/hash.h"
 #include "core/sparse_model.h"
 #include "pipeline/colmap.h"
+#include "pipeline/colmap_database.h"
 #include "pipeline/stage_cache.h"
 
 namespace parallax {
@@ -129,32 +130,33 @@ CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& 
   return {CameraModel::kPinhole, Join(options.intrinsics), true, true};
 }
 
-// The known model rewritten with the ids COLMAP's database gives the photos: images 1..N in
-// name order; one camera (id 1) when shared, else camera i for image i.
+// The known model rewritten with the ids COLMAP's database gave the photos, so that
+// point_triangulator can match its images and cameras to the features and matches.
 SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& photos,
-                                      const fs::path& known_dir) {
-  SparseModel aligned;
+                                      const fs::path& known_dir, const fs::path& database) {
+  const std::map<std::string, DatabaseImage> ids = ReadDatabaseImages(database);
   const bool single = known.Cameras().size() == 1;
-  if (single) {
-    Camera camera = known.Cameras().front();
-    camera.id = 1;
-    aligned.AddCamera(camera);
-  }
-  for (size_t i = 0; i < photos.photos.size(); ++i) {
-    const SparseImage* image = known.FindImageByName(photos.photos[i].name);
+  SparseModel aligned;
+  for (const Photo& photo : photos.photos) {
+    const SparseImage* image = known.FindImageByName(photo.name);
     if (!image) {
       throw BadInputError("--known-cameras " + known_dir.string() + " has no image named " +
-                          photos.photos[i].name);
+                          photo.name);
+    }
+    const auto id = ids.find(photo.name);
+    if (id == ids.end()) {
+      throw BadInputError(database.string() + " has no image named " + photo.name);
     }
     SparseImage copy = *image;
-    copy.id = static_cast<uint32_t>(i + 1);
+    copy.id = id->second.image_id;
+    copy.camera_id = id->second.camera_id;
     copy.points2d.clear();
-    if (!single) {
+    // One shared camera in the database when the known model has one (single_camera).
+    if (!(single && !aligned.Cameras().empty())) {
       Camera camera = known.CameraById(image->camera_id);
-      camera.id = copy.id;
+      camera.id = copy.camera_id;
       aligned.AddCamera(camera);
     }
-    copy.camera_id = single ? 1 : copy.id;
     aligned.AddImage(std::move(copy));
   }
   return aligned;
@@ -472,7 +474,8 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     const std::vector<std::string> common = {"--database_path", paths.Database().string(),
                                              "--image_path", photos_dir.string()};
     if (known) {
-      WriteSparseModel(AlignKnownModelToDatabase(*known, photos, options.known_cameras),
+      WriteSparseModel(AlignKnownModelToDatabase(*known, photos, options.known_cameras,
+                                                 paths.Database()),
                        paths.KnownModel(), SparseFormat::kBinary);
       fs::create_directories(models / "0");
       std::vector<std::string> arguments = common;
