@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
+#include "pipeline/depth_evaluation.h"
 #include "pipeline/evaluate.h"
 
 namespace parallax {
@@ -32,6 +33,30 @@ void PrintPoseTable(const PoseEvaluation& evaluation) {
               evaluation.alignment.inliers);
 }
 
+// Whether `dir` holds depth maps `<stem>.exr` (confidence maps `<stem>.confidence.exr` aside).
+bool HasDepthMaps(const std::filesystem::path& dir) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(dir, error)) return false;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && entry.path().extension() == ".exr" &&
+        !name.ends_with(".confidence.exr")) {
+      return true;
+    }
+  }
+  return false;
+}
+
+void PrintDepthSummary(const DepthEvaluation& evaluation, bool aligned,
+                       const std::filesystem::path& error_image_dir) {
+  std::printf("depth: %d views (%s); abs_rel median %.3f%%, signed median %+.3f%%; "
+              "within 1%% %.1f%%, within 2%% %.1f%%; completeness %.1f%%; error images %s\n",
+              evaluation.views, aligned ? "aligned" : "identity alignment",
+              100 * evaluation.abs_rel_median, 100 * evaluation.signed_median,
+              100 * evaluation.within_1pct, 100 * evaluation.within_2pct,
+              100 * evaluation.completeness, error_image_dir.string().c_str());
+}
+
 // Stage timings recorded by reconstruct, when the workspace has them.
 nlohmann::json ReconstructTimings(const std::filesystem::path& workspace) {
   const std::filesystem::path report = workspace / "report.json";
@@ -51,11 +76,13 @@ void RegisterEvaluateCommand(CLI::App& app) {
     std::filesystem::path workspace;
     std::filesystem::path scene;
     std::filesystem::path json;
+    bool no_align = false;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
       "evaluate", "Measure a workspace against a scene folder's ground truth: camera poses "
-                  "after a robust similarity alignment (Ceres).");
+                  "after a robust similarity alignment (Ceres) and, when the workspace has "
+                  "depth/, its depth maps in the ground-truth cameras.");
   command->add_option("workspace", arguments->workspace, "workspace made by reconstruct")
       ->required()
       ->check(CLI::ExistingDirectory);
@@ -64,6 +91,9 @@ void RegisterEvaluateCommand(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   command->add_option("--json", arguments->json,
                       "where to write the JSON (default <workspace>/evaluation.json)");
+  command->add_flag("--no-align", arguments->no_align,
+                    "compare depth without the estimated alignment (identity): for workspaces "
+                    "made with reconstruct --known-cameras, whose frame is the ground truth's");
   command->callback([arguments] {
     const SceneFolder scene{arguments->scene};
     const std::filesystem::path estimate_dir = arguments->workspace / "sparse";
@@ -71,11 +101,30 @@ void RegisterEvaluateCommand(CLI::App& app) {
       throw BadInputError(estimate_dir.string() + " holds no COLMAP model: run parallax "
                           "reconstruct first");
     }
-    const PoseEvaluation evaluation =
-        EvaluatePoses(ReadSparseModel(estimate_dir), ReadSparseModel(scene.Training().sparse));
+    const SparseModel estimate = ReadSparseModel(estimate_dir);
+    const SparseModel truth = ReadSparseModel(scene.Training().sparse);
+    const PoseEvaluation evaluation = EvaluatePoses(estimate, truth);
     PrintPoseTable(evaluation);
     nlohmann::json json = nlohmann::json::object();
     AddPoseSections(evaluation, json);
+
+    const std::filesystem::path depth_dir = arguments->workspace / "depth";
+    if (HasDepthMaps(depth_dir)) {
+      const std::filesystem::path error_image_dir =
+          arguments->workspace / "evaluation" / "depth_error";
+      const Similarity3d truth_from_estimate =
+          arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source;
+      const DepthEvaluation depth = EvaluateDepth(estimate, depth_dir, truth,
+                                                  scene.Training().depth, truth_from_estimate,
+                                                  error_image_dir);
+      if (depth.views > 0) {
+        PrintDepthSummary(depth, !arguments->no_align, error_image_dir);
+        AddDepthSection(depth, json);
+      } else {
+        std::printf("depth: no depth map in %s belongs to a ground-truth image\n",
+                    depth_dir.string().c_str());
+      }
+    }
     const nlohmann::json timings = ReconstructTimings(arguments->workspace);
     if (!timings.is_null()) json["timings_s"] = timings;
     const std::filesystem::path out =

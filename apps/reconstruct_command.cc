@@ -62,6 +62,7 @@ void RegisterReconstructCommand(CLI::App& app) {
     std::filesystem::path workspace;
     std::string intrinsics;
     std::string camera_model = "SIMPLE_RADIAL";
+    bool no_depth = false;
     ReconstructOptions options;
   };
   auto arguments = std::make_shared<Arguments>();
@@ -95,6 +96,8 @@ void RegisterReconstructCommand(CLI::App& app) {
   command->add_option("--known-cameras", arguments->options.known_cameras,
                       "COLMAP model folder with known intrinsics and poses: only triangulate")
       ->check(CLI::ExistingDirectory);
+  command->add_flag("--no-depth", arguments->no_depth,
+                    "stop after structure from motion (no multi-view stereo)");
   command->add_flag("--strict", arguments->options.strict,
                     "an implausible reconstruction is an error (exit 2), not a warning");
   command->add_flag("--dry-run", arguments->options.dry_run,
@@ -104,6 +107,7 @@ void RegisterReconstructCommand(CLI::App& app) {
   command->callback([arguments] {
     ReconstructOptions options = arguments->options;
     options.camera_model = CameraModelFromName(arguments->camera_model);
+    options.estimate_depth = !arguments->no_depth;
     if (!arguments->intrinsics.empty()) options.intrinsics = ParseIntrinsics(arguments->intrinsics);
     ReconstructSummary summary;
     {

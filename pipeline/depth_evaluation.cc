@@ -87,8 +87,8 @@ float TruthDepthAt(const DepthMap& truth, const Eigen::Vector2d& pixel, int x, i
   const int x0 = static_cast<int>(std::floor(fx));
   const int y0 = static_cast<int>(std::floor(fy));
   if (x0 >= 0 && y0 >= 0 && x0 + 1 < truth.Width() && y0 + 1 < truth.Height()) {
-    const std::array<float, 4> d = {truth.At(x0, y0), truth.At(x0 + 1, y0),
-                                    truth.At(x0, y0 + 1), truth.At(x0 + 1, y0 + 1)};
+    const std::array<double, 4> d = {truth.At(x0, y0), truth.At(x0 + 1, y0),
+                                     truth.At(x0, y0 + 1), truth.At(x0 + 1, y0 + 1)};
     const auto [lowest, highest] = std::minmax_element(d.begin(), d.end());
     if (*lowest > 0 && *highest <= kInterpolationMaxRatio * *lowest) {
       const double wx = fx - x0;
@@ -223,8 +223,8 @@ ViewResult EvaluateView(const SparseModel& estimate_model, const SparseImage& es
     ++samples.gt_valid_pixels;
     const Landing& landing = nearest[i];
     if (landing.truth_index < 0) continue;
-    const double signed_rel =
-        (static_cast<double>(landing.z) - landing.reference) / landing.reference;
+    const double reference = landing.reference;
+    const double signed_rel = (static_cast<double>(landing.z) - reference) / reference;
     const double abs_rel = std::abs(signed_rel);
     samples.abs_rel.push_back(abs_rel);
     samples.signed_rel.push_back(signed_rel);

@@ -14,6 +14,7 @@
 #include "core/sparse_model.h"
 #include "pipeline/colmap.h"
 #include "pipeline/colmap_database.h"
+#include "pipeline/mvs.h"
 #include "pipeline/stage_cache.h"
 
 namespace parallax {
@@ -69,6 +70,25 @@ uint64_t HashFolder(const fs::path& dir) {
   Hasher hasher;
   for (const fs::path& file : files) hasher.Add(file.filename().string()).Add(ReadFileBytes(file));
   return hasher.Value();
+}
+
+// Bump when the depth stage's results change for the same options, so caches recompute.
+constexpr const char* kMvsVersion = "patch-match-1";
+
+nlohmann::json MvsSummaryJson(const MvsSummary& mvs) {
+  nlohmann::json views = nlohmann::json::array();
+  for (const MvsViewReport& view : mvs.views) {
+    views.push_back({{"name", view.name},
+                     {"sources", view.sources},
+                     {"min_depth", view.min_depth},
+                     {"max_depth", view.max_depth},
+                     {"photometric_share", view.photometric_share},
+                     {"geometric_share", view.geometric_share}});
+  }
+  return {{"views", views},
+          {"skipped", mvs.skipped},
+          {"photometric_seconds", mvs.photometric_seconds},
+          {"geometric_seconds", mvs.geometric_seconds}};
 }
 
 void CheckWorkspaceWritable(const fs::path& workspace) {
@@ -296,6 +316,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
             {"median_triangulation_deg", plausibility.median_triangulation_deg},
             {"well_constrained_image_share", plausibility.well_constrained_image_share},
             {"problems", plausibility.problems}}},
+          {"depth", summary.depth_views},
           {"notes", summary.notes},
           {"warnings", summary.warnings}};
 }
@@ -570,6 +591,21 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   });
   const SparseModel model = ReadSparseModel(paths.Sparse());
   FillModelStatistics(model, photos, summary);
+
+  if (options.estimate_depth) {
+    const std::string depth_key = Hasher()
+                                      .Add(undistort_key)
+                                      .Add(kMvsVersion)
+                                      .Add(static_cast<uint64_t>(options.quality))
+                                      .Hex();
+    const fs::path views_file = workspace / "depth" / "views.json";
+    stages.Run("depth", depth_key, views_file, [&] {
+      const MvsSummary mvs =
+          RunMultiViewStereo(workspace, MvsOptionsFor(options.quality), progress);
+      WriteFileAtomically(views_file, MvsSummaryJson(mvs).dump(2) + "\n");
+    });
+    summary.depth_views = nlohmann::json::parse(ReadFileBytes(views_file));
+  }
   WriteReport(paths.Report(), summary);
   return summary;
 }

@@ -6,18 +6,18 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/camera.h"
 #include "core/progress.h"
 #include "pipeline/photo_set.h"
 #include "pipeline/plausibility.h"
+#include "pipeline/quality.h"
 
 namespace parallax {
 
-enum class Quality {
-  kFast,      // Images up to 1024 px, 2048 features: a quick look.
-  kBalanced,  // Images up to 2000 px, 4096 features: the default.
-  kBest,      // Images up to 3200 px, 8192 features, guided matching (COLMAP's defaults+).
-};
+// SfM at each Quality: fast: images up to 1024 px, 2048 features; balanced: 2000 px, 4096
+// features; best: 3200 px, 8192 features and guided matching.
 
 enum class MatcherChoice {
   kAuto,        // Exhaustive up to `exhaustive_limit` images, else sequential.
@@ -54,6 +54,8 @@ struct ReconstructOptions {
   // image size from the centre; further off it was not observable and drifted.
   double max_refined_principal_point_offset = 0.05;
   PlausibilityOptions plausibility;
+  // Run multi-view stereo after SfM (pipeline/mvs.h), at `quality`.
+  bool estimate_depth = true;
   void Check() const;  // Throws std::invalid_argument naming the field.
 };
 
@@ -77,6 +79,9 @@ struct ReconstructSummary {
   double mean_track_length = 0;
   double mean_reprojection_error_px = 0;
   PlausibilityReport plausibility;
+  // Multi-view stereo per view: source views chosen, depth range, valid shares (JSON, as
+  // written to <ws>/depth/views.json); null when depth was not estimated.
+  nlohmann::json depth_views;
   std::vector<std::string> notes;  // Decisions worth knowing (e.g. a refinement kept or not).
   std::vector<std::string> warnings;
 };

@@ -1,0 +1,69 @@
+#include "pipeline/depth_filter.h"
+
+#include <stdexcept>
+
+#include <tbb/parallel_for.h>
+
+namespace parallax {
+
+void GeometricFilterOptions::Check() const {
+  if (!(max_reprojection_px > 0)) throw std::invalid_argument("max_reprojection_px must be > 0");
+  if (!(max_relative_depth > 0)) throw std::invalid_argument("max_relative_depth must be > 0");
+  if (min_consistent_views < 1) throw std::invalid_argument("min_consistent_views must be >= 1");
+}
+
+FilteredDepth FilterGeometric(
+    const StereoView& reference, const DepthNormalMap& estimate,
+    const std::vector<std::pair<const StereoView*, const DepthNormalMap*>>& sources,
+    const GeometricFilterOptions& options) {
+  options.Check();
+  const int width = estimate.depth.Width(), height = estimate.depth.Height();
+  FilteredDepth result{DepthMap(width, height), DepthMap(width, height)};
+  std::vector<Rigid3d> source_from_ref, ref_from_source;
+  for (const auto& [view, map] : sources) {
+    source_from_ref.push_back(RelativePose(reference.cam_from_world, view->cam_from_world));
+    ref_from_source.push_back(source_from_ref.back().Inverse());
+  }
+  const double max_error_sq = options.max_reprojection_px * options.max_reprojection_px;
+  tbb::parallel_for(0, height, [&](int y) {
+    for (int x = 0; x < width; ++x) {
+      const float depth = estimate.depth.At(x, y);
+      if (!(depth > 0)) continue;
+      const Eigen::Vector2d pixel(x + 0.5, y + 0.5);
+      const std::optional<Eigen::Vector3d> point = reference.camera.Unproject(pixel, depth);
+      if (!point) continue;
+      int consistent = 0;
+      for (size_t s = 0; s < sources.size(); ++s) {
+        const auto& [view, map] = sources[s];
+        const std::optional<Eigen::Vector2d> in_source = view->camera.Project(source_from_ref[s] * *point);
+        if (!in_source) continue;
+        const int sx = static_cast<int>(std::floor(in_source->x()));
+        const int sy = static_cast<int>(std::floor(in_source->y()));
+        if (sx < 0 || sy < 0 || sx >= map->depth.Width() || sy >= map->depth.Height()) continue;
+        const float source_depth = map->depth.At(sx, sy);
+        if (!(source_depth > 0)) continue;
+        // Back from the source pixel centre at the source's depth, into the reference.
+        const std::optional<Eigen::Vector3d> back =
+            view->camera.Unproject({sx + 0.5, sy + 0.5}, source_depth);
+        if (!back) continue;
+        const Eigen::Vector3d back_in_ref = ref_from_source[s] * *back;
+        const std::optional<Eigen::Vector2d> reprojected = reference.camera.Project(back_in_ref);
+        if (!reprojected) continue;
+        if ((*reprojected - pixel).squaredNorm() <= max_error_sq &&
+            std::abs(back_in_ref.z() - static_cast<double>(depth)) <=
+                options.max_relative_depth * static_cast<double>(depth)) {
+          ++consistent;
+        }
+      }
+      if (consistent >= options.min_consistent_views) {
+        result.depth.At(x, y) = depth;
+        const float cost = estimate.cost[static_cast<size_t>(y) * width + x];
+        result.confidence.At(x, y) = static_cast<float>(consistent) /
+                                     static_cast<float>(sources.size()) * (1 - cost / 2);
+      }
+    }
+  });
+  return result;
+}
+
+}  // namespace parallax

@@ -1,0 +1,32 @@
+#pragma once
+// The geometric-consistency pass of multi-view stereo: a reference depth survives only where
+// it agrees with the source views' depth maps (reprojected there and back), and gets a
+// confidence from how many agree.
+#include <vector>
+
+#include "pipeline/patch_match.h"
+
+namespace parallax {
+
+struct GeometricFilterOptions {
+  // Round trip reference -> source depth -> reference must land within this many pixels ...
+  double max_reprojection_px = 1.0;
+  // ... at a depth within this relative difference.
+  double max_relative_depth = 0.01;
+  // Views that must agree for a depth to be kept.
+  int min_consistent_views = 1;
+  void Check() const;
+};
+
+struct FilteredDepth {
+  DepthMap depth;       // 0 where inconsistent.
+  DepthMap confidence;  // In [0, 1]: share of agreeing views times (1 - cost / 2); 0 = none.
+};
+
+// `sources[i]` is a source view with its photometric estimate.
+FilteredDepth FilterGeometric(
+    const StereoView& reference, const DepthNormalMap& estimate,
+    const std::vector<std::pair<const StereoView*, const DepthNormalMap*>>& sources,
+    const GeometricFilterOptions& options);
+
+}  // namespace parallax

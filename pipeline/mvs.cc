@@ -1,0 +1,180 @@
+#include "pipeline/mvs.h"
+
+#include <chrono>
+#include <map>
+
+#include "core/depth_map.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+GrayImage LoadGray(const fs::path& path) {
+  const Image image = ReadImage(path);
+  GrayImage gray{image.Width(), image.Height(), {}};
+  gray.values.resize(static_cast<size_t>(image.Width()) * image.Height());
+  const int channels = image.Channels();
+  for (size_t i = 0; i < gray.values.size(); ++i) {
+    const float* pixel = image.Pixels().data() + i * channels;
+    gray.values[i] = channels >= 3 ? 0.299f * pixel[0] + 0.587f * pixel[1] + 0.114f * pixel[2]
+                                   : pixel[0];
+  }
+  return gray;
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double ValidShare(const DepthMap& depth) {
+  size_t valid = 0;
+  for (const float value : depth.Values()) valid += value > 0;
+  return static_cast<double>(valid) / static_cast<double>(std::max<size_t>(1, depth.Values().size()));
+}
+
+DenseArray NormalArray(const DepthNormalMap& map, const DepthMap& keep) {
+  const int width = keep.Width(), height = keep.Height();
+  DenseArray array{width, height, 3, std::vector<float>(static_cast<size_t>(width) * height * 3)};
+  for (int c = 0; c < 3; ++c) {
+    for (size_t i = 0; i < static_cast<size_t>(width) * height; ++i) {
+      array.values[c * static_cast<size_t>(width) * height + i] =
+          keep.Values()[i] > 0 ? map.normal[3 * i + c] : 0.0f;
+    }
+  }
+  return array;
+}
+
+}  // namespace
+
+void MvsOptions::Check() const {
+  views.Check();
+  patch_match.Check();
+  filter.Check();
+}
+
+MvsOptions MvsOptionsFor(Quality quality) {
+  MvsOptions options;
+  switch (quality) {
+    case Quality::kFast:
+      options.views.max_sources = 3;
+      options.patch_match.iterations = 2;
+      options.patch_match.far_neighbour_offset = 0;
+      break;
+    case Quality::kBalanced:
+      break;
+    case Quality::kBest:
+      options.views.max_sources = 6;
+      options.patch_match.window_radius = 5;
+      options.patch_match.iterations = 4;
+      options.filter.min_consistent_views = 2;
+      break;
+  }
+  return options;
+}
+
+DepthMap ToColmapSampling(const DepthMap& depth) {
+  DepthMap sampled(depth.Width(), depth.Height());
+  for (int y = 0; y < depth.Height(); ++y) {
+    for (int x = 0; x < depth.Width(); ++x) {
+      sampled.At(x, y) = depth.At(x, y);
+      if (x == 0 || y == 0) continue;
+      const float corners[4] = {depth.At(x - 1, y - 1), depth.At(x, y - 1), depth.At(x - 1, y),
+                                depth.At(x, y)};
+      const auto [low, high] = std::minmax_element(corners, corners + 4);
+      if (!(*low > 0) || *high > *low * 1.01f) continue;
+      float inverse = 0;
+      for (const float corner : corners) inverse += 0.25f / corner;
+      sampled.At(x, y) = 1 / inverse;
+    }
+  }
+  return sampled;
+}
+
+MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& options,
+                              Progress& progress) {
+  options.Check();
+  const SparseModel model = ReadSparseModel(workspace / "sparse");
+  const std::vector<ViewPlan> plans = PlanViews(model, options.views);
+  MvsSummary summary;
+  if (plans.size() < model.Images().size()) {
+    for (const SparseImage& image : model.Images()) {
+      const bool planned = std::any_of(plans.begin(), plans.end(),
+                                       [&](const ViewPlan& plan) { return plan.image_id == image.id; });
+      if (!planned) summary.skipped.push_back(image.name + ": too few sparse points or no source view");
+    }
+  }
+
+  // Every image that takes part, as reference or as source, loaded once.
+  std::map<uint32_t, StereoView> views;
+  for (const ViewPlan& plan : plans) {
+    for (uint32_t id : plan.sources) views[id];
+    views[plan.image_id];
+  }
+  for (auto& [id, view] : views) {
+    const SparseImage& image = model.ImageById(id);
+    view.camera = model.CameraById(image.camera_id);
+    view.cam_from_world = image.cam_from_world;
+    view.image = LoadGray(workspace / "images" / image.name);
+  }
+
+  auto start = std::chrono::steady_clock::now();
+  std::map<uint32_t, DepthNormalMap> estimates;
+  for (size_t i = 0; i < plans.size(); ++i) {
+    progress.Update("depth", static_cast<int64_t>(i), static_cast<int64_t>(plans.size()));
+    const ViewPlan& plan = plans[i];
+    std::vector<const StereoView*> sources;
+    for (uint32_t id : plan.sources) sources.push_back(&views.at(id));
+    PatchMatchOptions patch_match = options.patch_match;
+    patch_match.min_depth = plan.min_depth;
+    patch_match.max_depth = plan.max_depth;
+    patch_match.seed = plan.image_id;
+    estimates[plan.image_id] = PatchMatchStereo(views.at(plan.image_id), sources, patch_match);
+  }
+  progress.Update("depth", static_cast<int64_t>(plans.size()), static_cast<int64_t>(plans.size()));
+  summary.photometric_seconds = Seconds(start);
+
+  start = std::chrono::steady_clock::now();
+  const fs::path stereo = workspace / "stereo";
+  for (size_t i = 0; i < plans.size(); ++i) {
+    progress.Update("filter", static_cast<int64_t>(i), static_cast<int64_t>(plans.size()));
+    const ViewPlan& plan = plans[i];
+    std::vector<std::pair<const StereoView*, const DepthNormalMap*>> sources;
+    for (uint32_t id : plan.sources) {
+      if (estimates.count(id)) sources.emplace_back(&views.at(id), &estimates.at(id));
+    }
+    const DepthNormalMap& estimate = estimates.at(plan.image_id);
+    const FilteredDepth filtered =
+        sources.empty() ? FilteredDepth{DepthMap(estimate.depth.Width(), estimate.depth.Height()),
+                                        DepthMap(estimate.depth.Width(), estimate.depth.Height())}
+                        : FilterGeometric(views.at(plan.image_id), estimate, sources, options.filter);
+
+    const std::string stem = fs::path(plan.name).stem().string();
+    WriteColmapDepth(stereo / "depth_maps" / (plan.name + ".photometric.bin"),
+                     ToColmapSampling(estimate.depth));
+    WriteColmapDepth(stereo / "depth_maps" / (plan.name + ".geometric.bin"),
+                     ToColmapSampling(filtered.depth));
+    WriteColmapArray(stereo / "normal_maps" / (plan.name + ".photometric.bin"),
+                     NormalArray(estimate, estimate.depth));
+    WriteColmapArray(stereo / "normal_maps" / (plan.name + ".geometric.bin"),
+                     NormalArray(estimate, filtered.depth));
+    WriteDepthExr(workspace / "depth" / (stem + ".exr"), filtered.depth);
+    WriteDepthExr(workspace / "depth" / (stem + ".confidence.exr"), filtered.confidence);
+
+    MvsViewReport report;
+    report.name = plan.name;
+    for (uint32_t id : plan.sources) report.sources.push_back(model.ImageById(id).name);
+    report.min_depth = plan.min_depth;
+    report.max_depth = plan.max_depth;
+    report.photometric_share = ValidShare(estimate.depth);
+    report.geometric_share = ValidShare(filtered.depth);
+    summary.views.push_back(std::move(report));
+  }
+  progress.Update("filter", static_cast<int64_t>(plans.size()), static_cast<int64_t>(plans.size()));
+  summary.geometric_seconds = Seconds(start);
+  return summary;
+}
+
+}  // namespace parallax

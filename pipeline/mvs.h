@@ -1,0 +1,55 @@
+#pragma once
+// Multi-view stereo over a workspace: for every view of <ws>/sparse (undistorted PINHOLE),
+// PatchMatch against its selected source views, then the geometric-consistency filter; writes
+// DESIGN.md's dense files (COLMAP format under <ws>/stereo, EXR depth + confidence under
+// <ws>/depth).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/progress.h"
+#include "pipeline/depth_filter.h"
+#include "pipeline/patch_match.h"
+#include "pipeline/quality.h"
+#include "pipeline/view_selection.h"
+
+namespace parallax {
+
+struct MvsOptions {
+  ViewSelectionOptions views;
+  PatchMatchOptions patch_match;  // Its depth range is set per view from the sparse points.
+  GeometricFilterOptions filter;
+  void Check() const;
+};
+
+// fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
+// balanced: 4 sources, 4x4 samples, 3 iterations, near and far neighbours;
+// best: 6 sources, 6x6 samples, 4 iterations.
+MvsOptions MvsOptionsFor(Quality quality);
+
+struct MvsViewReport {
+  std::string name;
+  std::vector<std::string> sources;
+  double min_depth = 0;
+  double max_depth = 0;
+  double photometric_share = 0;  // Share of pixels with a photometric depth.
+  double geometric_share = 0;    // Share left after the geometric filter.
+};
+
+struct MvsSummary {
+  std::vector<MvsViewReport> views;
+  std::vector<std::string> skipped;  // Views without depth, and why.
+  double photometric_seconds = 0;
+  double geometric_seconds = 0;
+};
+
+// Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
+MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,
+                              Progress& progress);
+
+// Depth at pixel centres (our convention) -> depth sampled at integer image points (x, y), as
+// COLMAP's dense code reads its maps: inverse depth averaged over the four surrounding pixel
+// centres where they agree (within 1%), else the pixel's own value.
+DepthMap ToColmapSampling(const DepthMap& depth);
+
+}  // namespace parallax

@@ -1,0 +1,93 @@
+#pragma once
+// Slanted-plane PatchMatch stereo on the CPU: per reference pixel a plane (depth + normal),
+// scored by bilaterally weighted NCC against several source views, with occlusion-aware
+// aggregation (the mean of the best views' costs, so one occluded view cannot veto a pixel).
+// Red-black propagation (neighbours' planes as candidates) and random refinement, the
+// random search sampled in inverse depth.
+//
+// Conventions: PINHOLE cameras (undistorted images), pixel centres at +0.5, depth is z-depth,
+// normals are camera-frame unit vectors facing the camera.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/camera.h"
+#include "core/depth_map.h"
+#include "core/pose.h"
+
+namespace parallax {
+
+// A greyscale image, intensities in [0, 1], row-major.
+struct GrayImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> values;
+  float At(int x, int y) const { return values[static_cast<size_t>(y) * width + x]; }
+};
+
+struct StereoView {
+  Camera camera;  // PINHOLE or SIMPLE_PINHOLE.
+  Rigid3d cam_from_world;
+  GrayImage image;
+};
+
+struct PatchMatchOptions {
+  // Matching window: samples every `window_step` pixels within `window_radius` of the centre.
+  int window_radius = 3;
+  int window_step = 2;
+  // Red-black sweeps, each over both colours.
+  int iterations = 3;
+  // Propagate from the 4 adjacent pixels, and also from 4 pixels `far_neighbour_offset` away
+  // (0 disables the far ones).
+  int far_neighbour_offset = 3;
+  // Bilateral weights: intensity difference scale (intensities in [0, 1]) and spatial scale
+  // in pixels.
+  float sigma_color = 0.12f;
+  float sigma_spatial_px = 3.0f;
+  // The aggregated cost is the mean of the best ceil(views * best_view_fraction) view costs.
+  float best_view_fraction = 0.5f;
+  // Windows whose weighted standard deviation is below this are textureless: no depth.
+  float min_texture_std = 0.01f;
+  // Pixels whose final cost (1 - NCC, in [0, 2]) exceeds this get depth 0.
+  float max_cost = 0.6f;
+  // Depth search range (scene units); the random search is uniform in inverse depth.
+  double min_depth = 0.1;
+  double max_depth = 100;
+  // Normals more oblique than this to the viewing ray (degrees) are not proposed.
+  double max_normal_angle_deg = 80;
+  uint32_t seed = 1;
+  void Check() const;  // Throws std::invalid_argument naming the field.
+};
+
+struct DepthNormalMap {
+  DepthMap depth;             // 0 where no depth was found.
+  std::vector<float> normal;  // 3 per pixel (camera frame); 0 where no depth.
+  std::vector<float> cost;    // Aggregated 1 - NCC per pixel, in [0, 2].
+};
+
+// Estimates depth and normal for every pixel of `reference` from `sources` (at least one).
+// Uses every thread of the calling TBB arena; the result does not depend on the thread count.
+// Throws std::invalid_argument for unsupported cameras or size mismatches.
+DepthNormalMap PatchMatchStereo(const StereoView& reference,
+                                const std::vector<const StereoView*>& sources,
+                                const PatchMatchOptions& options);
+
+// Building blocks, exposed for tests.
+
+// The homography mapping reference pixels on the plane {X : n.X = rho} (reference camera frame)
+// to source pixels: H = K_s (R + t n^T / rho) K_r^-1 with (R, t) = source_from_reference.
+Eigen::Matrix3d PlaneHomography(const Camera& reference, const Camera& source,
+                                const Rigid3d& source_from_reference, const Eigen::Vector3d& normal,
+                                double rho);
+
+// Bilaterally weighted NCC cost 1 - NCC in [0, 2] between the reference window around
+// (x, y) and the source window the homography maps it to; 2 when the source window leaves the
+// image or either window is textureless.
+float WindowCost(const GrayImage& reference, int x, int y, const GrayImage& source,
+                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options);
+
+// Depth `fraction` of the way from min to max depth, linear in inverse depth.
+double InverseDepthSample(double min_depth, double max_depth, double fraction);
+
+}  // namespace parallax
