@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
@@ -169,9 +170,12 @@ float SourceCost(const SourceProjection& source, const Eigen::Matrix3f& h, float
 
 class PatchMatcher {
  public:
+  // `initial` (may be null) proposes a plane per pixel, e.g. from a coarser pyramid level;
+  // pixels without one (depth 0) start from a random plane.
   PatchMatcher(const StereoView& reference, const std::vector<const StereoView*>& sources,
-               const PatchMatchOptions& options)
+               const PatchMatchOptions& options, const DepthNormalMap* initial)
       : reference_(reference),
+        initial_(initial),
         options_(options),
         pattern_(options),
         windows_(reference.image, pattern_, options),
@@ -302,8 +306,22 @@ class PatchMatcher {
 
   void Initialise(int x, int y) {
     if (!Textured(x, y)) return;  // Stays at depth 0, cost 2.
-    const Plane plane{RandomDepth(x, y, -1, 0), RandomNormal(x, y, -1, 1)};
-    Store(x, y, plane, Cost(x, y, plane));
+    const Plane random{RandomDepth(x, y, -1, 0), RandomNormal(x, y, -1, 1)};
+    if (initial_ && initial_->depth.At(x, y) > 0) {
+      const size_t i = Index(x, y);
+      const Plane proposed{initial_->depth.At(x, y), Eigen::Vector3f(&initial_->normal[3 * i])};
+      if (Acceptable(x, y, proposed)) {
+        const float proposed_cost = Cost(x, y, proposed);
+        const float random_cost = Cost(x, y, random);
+        if (proposed_cost <= random_cost) {
+          Store(x, y, proposed, proposed_cost);
+        } else {
+          Store(x, y, random, random_cost);
+        }
+        return;
+      }
+    }
+    Store(x, y, random, Cost(x, y, random));
   }
 
   void Improve(int x, int y, int iteration) {
@@ -311,6 +329,11 @@ class PatchMatcher {
     Plane best = StoredPlane(x, y);
     float best_cost = result_.cost[Index(x, y)];
     auto consider = [&](const Plane& candidate) {
+      // Converged neighbourhoods propose the plane this pixel already has: skip the rescoring.
+      if (std::abs(candidate.depth - best.depth) <= 1e-6f * best.depth &&
+          candidate.normal.dot(best.normal) >= 1 - 1e-7f) {
+        return;
+      }
       if (!Acceptable(x, y, candidate)) return;
       const float cost = Cost(x, y, candidate);
       if (cost < best_cost) {
@@ -344,6 +367,7 @@ class PatchMatcher {
   }
 
   const StereoView& reference_;
+  const DepthNormalMap* initial_;
   const PatchMatchOptions& options_;
   WindowPattern pattern_;
   ReferenceWindows windows_;
@@ -356,6 +380,86 @@ class PatchMatcher {
   DepthNormalMap result_;
 };
 
+StereoView HalfResolution(const StereoView& view) {
+  StereoView half;
+  half.cam_from_world = view.cam_from_world;
+  half.camera = view.camera;
+  half.image.width = view.image.width / 2;
+  half.image.height = view.image.height / 2;
+  half.camera.width = static_cast<uint64_t>(half.image.width);
+  half.camera.height = static_cast<uint64_t>(half.image.height);
+  // Pixel centres at +0.5 make the continuous coordinates scale exactly by one half.
+  const double sx = static_cast<double>(half.image.width) / view.image.width;
+  const double sy = static_cast<double>(half.image.height) / view.image.height;
+  if (half.camera.model == CameraModel::kSimplePinhole) {
+    half.camera.model = CameraModel::kPinhole;
+    half.camera.params = {view.camera.params[0], view.camera.params[0], view.camera.params[1],
+                          view.camera.params[2]};
+  }
+  half.camera.params[0] *= sx;
+  half.camera.params[1] *= sy;
+  half.camera.params[2] *= sx;
+  half.camera.params[3] *= sy;
+  half.image.values.resize(static_cast<size_t>(half.image.width) * half.image.height);
+  for (int y = 0; y < half.image.height; ++y) {
+    for (int x = 0; x < half.image.width; ++x) {
+      half.image.values[static_cast<size_t>(y) * half.image.width + x] =
+          0.25f * (view.image.At(2 * x, 2 * y) + view.image.At(2 * x + 1, 2 * y) +
+                   view.image.At(2 * x, 2 * y + 1) + view.image.At(2 * x + 1, 2 * y + 1));
+    }
+  }
+  return half;
+}
+
+// Each fine pixel takes the plane of the coarse pixel it lies in, intersected with its own
+// ray (planes are 3D: the same in every level's camera).
+DepthNormalMap UpsamplePlanes(const DepthNormalMap& coarse, const Camera& coarse_camera,
+                              const Camera& fine_camera) {
+  const int width = static_cast<int>(fine_camera.width), height = static_cast<int>(fine_camera.height);
+  DepthNormalMap fine{DepthMap(width, height), std::vector<float>(static_cast<size_t>(width) * height * 3, 0.0f),
+                      std::vector<float>(static_cast<size_t>(width) * height, kInvalidCost)};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const int cx = std::min(x / 2, coarse.depth.Width() - 1);
+      const int cy = std::min(y / 2, coarse.depth.Height() - 1);
+      const float depth = coarse.depth.At(cx, cy);
+      if (!(depth > 0)) continue;
+      const size_t ci = static_cast<size_t>(cy) * coarse.depth.Width() + cx;
+      const Eigen::Vector3d normal(coarse.normal[3 * ci], coarse.normal[3 * ci + 1], coarse.normal[3 * ci + 2]);
+      const double rho = static_cast<double>(depth) * normal.dot(*coarse_camera.Unproject({cx + 0.5, cy + 0.5}));
+      const double n_dot_ray = normal.dot(*fine_camera.Unproject({x + 0.5, y + 0.5}));
+      if (!(n_dot_ray < 0)) continue;
+      const size_t i = static_cast<size_t>(y) * width + x;
+      fine.depth.At(x, y) = static_cast<float>(rho / n_dot_ray);
+      std::copy_n(&coarse.normal[3 * ci], 3, &fine.normal[3 * i]);
+    }
+  }
+  return fine;
+}
+
+// Coarse to fine: the coarser levels find the surfaces cheaply and over long distances, the
+// finer ones refine them.
+DepthNormalMap PatchMatchLevel(const StereoView& reference,
+                               const std::vector<const StereoView*>& sources,
+                               const PatchMatchOptions& options, int levels) {
+  std::optional<DepthNormalMap> initial;
+  const int min_size = 4 * options.window_radius + 8;
+  if (levels > 1 && reference.image.width / 2 >= min_size && reference.image.height / 2 >= min_size) {
+    const StereoView coarse_reference = HalfResolution(reference);
+    std::vector<StereoView> coarse_sources;
+    coarse_sources.reserve(sources.size());
+    for (const StereoView* source : sources) coarse_sources.push_back(HalfResolution(*source));
+    std::vector<const StereoView*> coarse_pointers;
+    for (const StereoView& source : coarse_sources) coarse_pointers.push_back(&source);
+    PatchMatchOptions coarse_options = options;
+    coarse_options.max_cost = 2;  // Keep every plane as a proposal; this level scores them.
+    const DepthNormalMap coarse =
+        PatchMatchLevel(coarse_reference, coarse_pointers, coarse_options, levels - 1);
+    initial = UpsamplePlanes(coarse, coarse_reference.camera, reference.camera);
+  }
+  return PatchMatcher(reference, sources, options, initial ? &*initial : nullptr).Run();
+}
+
 }  // namespace
 
 void PatchMatchOptions::Check() const {
@@ -365,7 +469,8 @@ void PatchMatchOptions::Check() const {
   require(window_radius >= 1 && window_radius <= 15, "window_radius must be in [1, 15]");
   require(window_step >= 1 && window_step <= window_radius, "window_step must be in [1, window_radius]");
   require(iterations >= 0, "iterations must be >= 0");
-  require(far_neighbour_offset >= 0 && far_neighbour_offset % 2 == 1 || far_neighbour_offset == 0,
+  require(pyramid_levels >= 1 && pyramid_levels <= 6, "pyramid_levels must be in [1, 6]");
+  require((far_neighbour_offset >= 0 && far_neighbour_offset % 2 == 1) || far_neighbour_offset == 0,
           "far_neighbour_offset must be 0 or odd (red-black propagation)");
   require(sigma_color > 0 && sigma_spatial_px > 0, "sigma_color and sigma_spatial_px must be > 0");
   require(best_view_fraction > 0 && best_view_fraction <= 1, "best_view_fraction must be in (0, 1]");
@@ -412,7 +517,7 @@ DepthNormalMap PatchMatchStereo(const StereoView& reference,
   }
   CheckPinhole(reference.camera, reference.image);
   for (const StereoView* source : sources) CheckPinhole(source->camera, source->image);
-  return PatchMatcher(reference, sources, options).Run();
+  return PatchMatchLevel(reference, sources, options, options.pyramid_levels);
 }
 
 }  // namespace parallax

@@ -36,8 +36,10 @@ struct PatchMatchOptions {
   // Matching window: samples every `window_step` pixels within `window_radius` of the centre.
   int window_radius = 3;
   int window_step = 2;
-  // Red-black sweeps, each over both colours.
+  // Red-black sweeps, each over both colours, at every pyramid level.
   int iterations = 3;
+  // Coarse-to-fine levels (each half the size of the next); 1 = full resolution only.
+  int pyramid_levels = 3;
   // Propagate from the 4 adjacent pixels, and also from 4 pixels `far_neighbour_offset` away
   // (0 disables the far ones).
   int far_neighbour_offset = 3;
@@ -48,7 +50,7 @@ struct PatchMatchOptions {
   // The aggregated cost is the mean of the best ceil(views * best_view_fraction) view costs.
   float best_view_fraction = 0.5f;
   // Windows whose weighted standard deviation is below this are textureless: no depth.
-  float min_texture_std = 0.01f;
+  float min_texture_std = 0.004f;
   // Pixels whose final cost (1 - NCC, in [0, 2]) exceeds this get depth 0.
   float max_cost = 0.6f;
   // Depth search range (scene units); the random search is uniform in inverse depth.

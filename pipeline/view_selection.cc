@@ -75,8 +75,10 @@ std::vector<ViewPlan> PlanViews(const SparseModel& model, const ViewSelectionOpt
     std::sort(z.begin(), z.end());
     const double near = z[z.size() / 100];
     const double far = z[z.size() - 1 - z.size() / 100];
+    // Background often lies beyond every sparse point (far ground, walls): the far end is
+    // doubled as well, which costs little in inverse depth.
     plan.min_depth = near * (1 - options.depth_margin);
-    plan.max_depth = far / (1 - options.depth_margin);
+    plan.max_depth = 2 * far / (1 - options.depth_margin);
     plans.push_back(std::move(plan));
   }
   return plans;

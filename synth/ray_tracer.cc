@@ -163,7 +163,7 @@ struct RayTracer::Impl {
 
   explicit Impl(const SceneDesc& scene_in) : scene(scene_in) {}
 
-  SurfaceSample Surface(const RTCRayHit& ray) const;
+  SurfaceSample Surface(const RTCRayHit& ray, double focal_px) const;
   Eigen::Vector3f Shade(const SurfaceSample& surface, const float* light_visible) const;
   RTCRay ShadowRay(const SurfaceSample& surface, const LightDesc& light) const;
   void RenderRow(const Camera& camera, const Rigid3d& cam_from_world, int y,
@@ -212,7 +212,7 @@ RayTracer::~RayTracer() {
   if (impl_->device) rtcReleaseDevice(impl_->device);
 }
 
-SurfaceSample RayTracer::Impl::Surface(const RTCRayHit& ray) const {
+SurfaceSample RayTracer::Impl::Surface(const RTCRayHit& ray, double focal_px) const {
   SurfaceSample surface;
   if (ray.hit.geomID == RTC_INVALID_GEOMETRY_ID) return surface;
   surface.hit = true;
@@ -235,7 +235,11 @@ SurfaceSample RayTracer::Impl::Surface(const RTCRayHit& ray) const {
   surface.normal.normalize();
   if (surface.normal.dot(surface.view) < 0) surface.normal = -surface.normal;
   surface.material = &scene.materials.at(object.material);
-  surface.albedo = EvaluateTexture(surface.material->texture, surface.point);
+  // One pixel's footprint on the surface, stretched by the viewing obliquity (capped).
+  const double distance = static_cast<double>(ray.ray.tfar) * direction.norm();
+  const double obliquity = std::max(0.2, std::abs(surface.normal.dot(surface.view)));
+  surface.albedo = EvaluateTexture(surface.material->texture, surface.point,
+                                   distance / focal_px / obliquity);
   return surface;
 }
 
@@ -311,7 +315,7 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
   const size_t num_lights = scene.lights.size();
   std::vector<RTCRay> shadow_rays(rays.size() * num_lights);
   for (size_t i = 0; i < rays.size(); ++i) {
-    surfaces[i] = Surface(rays[i]);
+    surfaces[i] = Surface(rays[i], camera.FocalX());
     for (size_t l = 0; l < num_lights; ++l) {
       // A miss gets a ray that is already "done" (tnear > tfar) so the batch stays aligned.
       RTCRay& shadow = shadow_rays[i * num_lights + l];

@@ -20,6 +20,13 @@ float LatticeValue(int64_t x, int64_t y, int64_t z, uint32_t seed) {
   return static_cast<float>(h >> 40) / static_cast<float>(1ull << 24);
 }
 
+// Pushes noise (centred on 0.5, spread ~0.1) towards 0 and 1 by `contrast` (the slope at
+// 0.5 is 2 * contrast). A tanh rather than a clamp: saturated regions keep their fine detail,
+// compressed, instead of turning into flat blobs that no stereo matcher can use.
+float Stretch(float noise, float contrast) {
+  return 0.5f + 0.5f * std::tanh(4 * contrast * (noise - 0.5f));
+}
+
 double Quintic(double t) { return t * t * t * (t * (t * 6 - 15) + 10); }
 
 }  // namespace
@@ -40,12 +47,19 @@ float ValueNoise(const Eigen::Vector3d& point, uint32_t seed) {
   return static_cast<float>(result);
 }
 
-float FractalNoise(const Eigen::Vector3d& point, double scale, int octaves, uint32_t seed) {
+float FractalNoise(const Eigen::Vector3d& point, double scale, int octaves, uint32_t seed,
+                   double footprint) {
   double sum = 0, total_weight = 0, weight = 1, frequency = 1 / scale;
   for (int octave = 0; octave < octaves; ++octave) {
+    // Octaves finer than the pixel footprint would alias, differently in every view: fade
+    // them out between two footprints and one, leaving their mean (0.5) in their place.
+    const double wavelength = 1 / frequency;
+    const double kept = std::clamp(wavelength / footprint - 1, 0.0, 1.0);
     // A different seed per octave keeps the layers' lattices from lining up.
-    sum += weight * static_cast<double>(
-        ValueNoise(point * frequency, seed + 1013u * static_cast<uint32_t>(octave)));
+    const double noise = kept > 0 ? static_cast<double>(ValueNoise(
+                                        point * frequency, seed + 1013u * static_cast<uint32_t>(octave)))
+                                  : 0.5;
+    sum += weight * (kept * noise + (1 - kept) * 0.5);
     total_weight += weight;
     weight *= 0.6;
     frequency *= 2;
@@ -53,23 +67,29 @@ float FractalNoise(const Eigen::Vector3d& point, double scale, int octaves, uint
   return static_cast<float>(sum / total_weight);
 }
 
-Eigen::Vector3f EvaluateTexture(const TextureDesc& texture, const Eigen::Vector3d& point) {
+Eigen::Vector3f EvaluateTexture(const TextureDesc& texture, const Eigen::Vector3d& point,
+                                double footprint) {
   switch (texture.type) {
     case TextureType::kFbm: {
-      const float noise = FractalNoise(point, texture.scale, texture.octaves, texture.seed);
-      const float t = std::clamp(0.5f + texture.contrast * 2 * (noise - 0.5f), 0.0f, 1.0f);
+      const float t = Stretch(FractalNoise(point, texture.scale, texture.octaves, texture.seed, footprint),
+                              texture.contrast);
       return texture.color_a + t * (texture.color_b - texture.color_a);
     }
     case TextureType::kChecker: {
-      const Eigen::Vector3d cell = (point / texture.scale).array().floor();
+      // Cells are centred on the lattice points: axis-aligned surfaces through the origin
+      // (the ground z = 0) then lie mid-cell, not on a cell boundary where float rounding of
+      // the hit point would flip the parity from pixel to pixel.
+      const Eigen::Vector3d cell = (point / texture.scale).array() + 0.5;
+      const Eigen::Vector3d cell_index = cell.array().floor();
       const int64_t parity =
-          static_cast<int64_t>(cell.x()) + static_cast<int64_t>(cell.y()) +
-          static_cast<int64_t>(cell.z());
+          static_cast<int64_t>(cell_index.x()) + static_cast<int64_t>(cell_index.y()) +
+          static_cast<int64_t>(cell_index.z());
       const Eigen::Vector3f base = (parity & 1) ? texture.color_b : texture.color_a;
       // Fine noise inside each cell gives matchers something besides the cell corners.
-      const float detail =
-          FractalNoise(point, texture.scale / 4, texture.octaves, texture.seed);
-      return base * (0.6f + 0.8f * detail);
+      const float detail = Stretch(
+          FractalNoise(point, texture.scale / 4, texture.octaves, texture.seed, footprint),
+          texture.contrast);
+      return base * (0.5f + detail);
     }
   }
   return texture.color_a;
