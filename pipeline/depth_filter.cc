@@ -10,6 +10,9 @@
 namespace parallax {
 namespace {
 
+// Relative depth change whose image motion measures how well a depth is constrained.
+constexpr double kSensitivityStep = 0.01;
+
 // Depth of `map` at a continuous pixel position: inverse depth interpolated between the four
 // nearest pixel centres where they belong to one surface (within 5%), else the nearest pixel.
 // Sampling the nearest pixel alone would fail the 1% test on grazing surfaces, where depth
@@ -43,6 +46,7 @@ void GeometricFilterOptions::Check() const {
   if (!(max_reprojection_px > 0)) throw std::invalid_argument("max_reprojection_px must be > 0");
   if (!(max_relative_depth > 0)) throw std::invalid_argument("max_relative_depth must be > 0");
   if (min_consistent_views < 1) throw std::invalid_argument("min_consistent_views must be >= 1");
+  if (!(min_parallax_px > 0)) throw std::invalid_argument("min_parallax_px must be > 0");
 }
 
 FilteredDepth FilterGeometric(
@@ -66,10 +70,14 @@ FilteredDepth FilterGeometric(
       const std::optional<Eigen::Vector3d> point = reference.camera.Unproject(pixel, depth);
       if (!point) continue;
       int consistent = 0;
+      double sensitivity_px = 0;  // Largest image motion in a source for a 1% depth change.
       for (size_t s = 0; s < sources.size(); ++s) {
         const auto& [view, map] = sources[s];
         const std::optional<Eigen::Vector2d> in_source = view->camera.Project(source_from_ref[s] * *point);
         if (!in_source) continue;
+        const std::optional<Eigen::Vector2d> nearer =
+            view->camera.Project(source_from_ref[s] * (*point * (1 - kSensitivityStep)));
+        if (nearer) sensitivity_px = std::max(sensitivity_px, (*nearer - *in_source).norm());
         const std::optional<double> source_depth = SampleDepth(map->depth, *in_source);
         if (!source_depth) continue;
         // Back from where the point landed, at the source's depth, into the reference.
@@ -87,8 +95,12 @@ FilteredDepth FilterGeometric(
       if (consistent >= options.min_consistent_views) {
         result.depth.At(x, y) = depth;
         const float cost = estimate.cost[static_cast<size_t>(y) * width + x];
-        result.confidence.At(x, y) = static_cast<float>(consistent) /
-                                     static_cast<float>(sources.size()) * (1 - cost / 2);
+        // A depth the views barely constrain (tiny baseline) is not a confident one, however
+        // well the windows match: confidence falls with the parallax a 1% change causes.
+        const double resolvable = std::min(1.0, sensitivity_px / options.min_parallax_px);
+        result.confidence.At(x, y) = static_cast<float>(
+            resolvable * consistent / static_cast<double>(sources.size()) *
+            (1 - static_cast<double>(cost) / 2));
       }
     }
   });

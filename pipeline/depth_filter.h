@@ -15,12 +15,17 @@ struct GeometricFilterOptions {
   double max_relative_depth = 0.01;
   // Views that must agree for a depth to be kept.
   int min_consistent_views = 1;
+  // Full confidence needs a 1% depth change to move the point at least this many pixels in
+  // some source view; below, confidence falls proportionally (tiny baselines).
+  double min_parallax_px = 1.0;
   void Check() const;
 };
 
 struct FilteredDepth {
   DepthMap depth;       // 0 where inconsistent.
-  DepthMap confidence;  // In [0, 1]: share of agreeing views times (1 - cost / 2); 0 = none.
+  // In [0, 1]: share of agreeing views x (1 - cost / 2) x how well the baseline resolves
+  // depth (see min_parallax_px); 0 where there is no depth.
+  DepthMap confidence;
 };
 
 // `sources[i]` is a source view with its photometric estimate.
