@@ -9,7 +9,9 @@
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "pipeline/depth_evaluation.h"
+#include "pipeline/cloud_evaluation.h"
 #include "pipeline/evaluate.h"
+#include "pipeline/fusion.h"
 
 namespace parallax {
 namespace {
@@ -124,6 +126,20 @@ void RegisterEvaluateCommand(CLI::App& app) {
         std::printf("depth: no depth map in %s belongs to a ground-truth image\n",
                     depth_dir.string().c_str());
       }
+    }
+    const std::filesystem::path fused = arguments->workspace / "fused.ply";
+    if (std::filesystem::exists(fused)) {
+      const CloudAccuracy cloud = MeasureCloud(
+          ReadPlyPositions(fused), truth, scene.Training().depth,
+          arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source);
+      std::printf("fused cloud: %zu points, %zu on ground-truth surfaces; median relative "
+                  "distance %.3f%%, within 1%% %.1f%%\n",
+                  cloud.points, cloud.measured, 100 * cloud.median_relative_distance,
+                  100 * cloud.within_1pct);
+      json["fused"] = {{"points", cloud.points},
+                       {"measured", cloud.measured},
+                       {"median_relative_distance", cloud.median_relative_distance},
+                       {"within_1pct", cloud.within_1pct}};
     }
     const nlohmann::json timings = ReconstructTimings(arguments->workspace);
     if (!timings.is_null()) json["timings_s"] = timings;

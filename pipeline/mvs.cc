@@ -66,10 +66,9 @@ MvsOptions MvsOptionsFor(Quality quality) {
     case Quality::kBalanced:
       break;
     case Quality::kBest:
-      options.views.max_sources = 6;
-      options.patch_match.window_radius = 5;
+      options.views.max_sources = 5;
+      options.patch_match.window_radius = 4;
       options.patch_match.iterations = 4;
-      options.filter.min_consistent_views = 2;
       break;
   }
   return options;

@@ -14,6 +14,7 @@
 #include "core/sparse_model.h"
 #include "pipeline/colmap.h"
 #include "pipeline/colmap_database.h"
+#include "pipeline/fusion.h"
 #include "pipeline/mvs.h"
 #include "pipeline/stage_cache.h"
 
@@ -74,6 +75,7 @@ uint64_t HashFolder(const fs::path& dir) {
 
 // Bump when the depth stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-1";
+constexpr const char* kFusionVersion = "fusion-1";
 
 nlohmann::json MvsSummaryJson(const MvsSummary& mvs) {
   nlohmann::json views = nlohmann::json::array();
@@ -605,6 +607,11 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
       WriteFileAtomically(views_file, MvsSummaryJson(mvs).dump(2) + "\n");
     });
     summary.depth_views = nlohmann::json::parse(ReadFileBytes(views_file));
+
+    const fs::path fused = workspace / "fused.ply";
+    stages.Run("fusion", Hasher().Add(depth_key).Add(kFusionVersion).Hex(), fused, [&] {
+      WritePly(fused, FuseWorkspace(workspace, {}, progress));
+    });
   }
   WriteReport(paths.Report(), summary);
   return summary;

@@ -8,7 +8,9 @@
 #include "core/error.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
+#include "pipeline/cloud_evaluation.h"
 #include "pipeline/colmap.h"
+#include "pipeline/fusion.h"
 #include "pipeline/depth_evaluation.h"
 #include "pipeline/evaluate.h"
 #include "tests/temp_dir.h"
@@ -93,6 +95,24 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_GT(depth.completeness, 0.65);
   EXPECT_LT(depth.abs_rel_median, 0.002);
   EXPECT_LT(std::abs(depth.signed_median), 0.001);
+
+  // Our fusion, and COLMAP's own stereo_fusion run on our dense workspace: COLMAP accepts it,
+  // and both clouds lie on the true surfaces.
+  const CloudAccuracy ours = MeasureCloud(ReadPlyPositions(workspace.Path() / "fused.ply"), truth,
+                                          scene.Training().depth, {});
+  EXPECT_GT(ours.points, 50000u);
+  EXPECT_LT(ours.median_relative_distance, 0.005);
+  EXPECT_GT(ours.within_1pct, 0.9);
+  const std::filesystem::path colmap_ply = workspace.Path() / "colmap_fused.ply";
+  Colmap().Run("stereo_fusion",
+               {"--workspace_path", workspace.Path().string(), "--workspace_format", "COLMAP",
+                "--input_type", "geometric", "--output_path", colmap_ply.string()},
+               workspace.Path() / "logs" / "stereo_fusion.log", "stereo_fusion", 0, progress);
+  const CloudAccuracy theirs =
+      MeasureCloud(ReadPlyPositions(colmap_ply), truth, scene.Training().depth, {});
+  EXPECT_GT(theirs.points, ours.points / 20);  // COLMAP keeps points seen by 5+ views; we 2+.
+  EXPECT_LT(theirs.median_relative_distance, 0.005);
+  EXPECT_GT(theirs.within_1pct, 0.9);
 }
 
 TEST(Colmap, AFailingCommandNamesTheToolStatusAndLog) {

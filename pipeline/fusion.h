@@ -1,0 +1,46 @@
+#pragma once
+// Fuses the filtered depth maps of a workspace into one point cloud: each pixel's 3D point is
+// merged with the pixels of the other views that see the same surface (depth within 1%,
+// normals within 20 degrees), and kept when enough views agree.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/progress.h"
+
+namespace parallax {
+
+struct FusionOptions {
+  // Views (the pixel's own included) that must see a point for it to be kept.
+  int min_views = 2;
+  // Another view's depth agrees when within this relative difference ...
+  double max_relative_depth = 0.01;
+  // ... and its normal within this angle (degrees).
+  double max_normal_angle_deg = 20;
+  void Check() const;
+};
+
+struct FusedPoint {
+  Eigen::Vector3f position;
+  Eigen::Vector3f normal;         // Unit, world frame.
+  std::array<uint8_t, 3> colour;  // sRGB.
+  uint16_t views = 0;             // How many pixels were merged.
+};
+
+// Reads <ws>/sparse, <ws>/images, <ws>/depth/<stem>.exr and the geometric normal maps under
+// <ws>/stereo/normal_maps. Views without a depth map are left out. Deterministic.
+std::vector<FusedPoint> FuseWorkspace(const std::filesystem::path& workspace,
+                                      const FusionOptions& options, Progress& progress);
+
+// Binary little-endian PLY with x y z nx ny nz (float) and red green blue (uchar), written
+// atomically. The format COLMAP's fused.ply uses.
+void WritePly(const std::filesystem::path& path, const std::vector<FusedPoint>& points);
+
+// Reads the vertex positions of a binary little-endian PLY whose vertex element starts with
+// float x, y, z (ours and COLMAP's). Throws BadInputError naming the file otherwise.
+std::vector<Eigen::Vector3f> ReadPlyPositions(const std::filesystem::path& path);
+
+}  // namespace parallax
