@@ -28,4 +28,21 @@ class Hasher {
   uint64_t state_ = 0xcbf29ce484222325ull;
 };
 
+// Murmur3's 64-bit finaliser: every input bit reaches every output bit. Deterministic
+// pseudo-random numbers keyed by coordinates (procedural textures, PatchMatch proposals)
+// start from it, so results never depend on thread scheduling.
+inline uint64_t MixBits(uint64_t h) {
+  h ^= h >> 33;
+  h *= 0xFF51AFD7ED558CCDull;
+  h ^= h >> 33;
+  h *= 0xC4CEB9FE1A85EC53ull;
+  h ^= h >> 33;
+  return h;
+}
+
+// The top 24 bits of a mixed hash as a float in [0, 1).
+inline float UnitFloat(uint64_t mixed) {
+  return static_cast<float>(mixed >> 40) / static_cast<float>(1ull << 24);
+}
+
 }  // namespace parallax

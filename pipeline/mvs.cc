@@ -66,9 +66,10 @@ MvsOptions MvsOptionsFor(Quality quality) {
     case Quality::kBalanced:
       break;
     case Quality::kBest:
+      // Measured: a larger window (5x5 samples) or two agreeing views lower completeness more
+      // than they lower the error; more sources and sweeps do not.
       options.views.max_sources = 5;
-      options.patch_match.window_radius = 4;
-      options.patch_match.iterations = 4;
+      options.patch_match.iterations = 5;
       break;
   }
   return options;

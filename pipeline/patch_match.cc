@@ -10,6 +10,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/hash.h"
+
 namespace parallax {
 namespace {
 
@@ -21,12 +23,7 @@ float Random(uint32_t seed, int x, int y, int iteration, int salt) {
   uint64_t h = seed * 0x9E3779B97F4A7C15ull;
   h ^= (static_cast<uint64_t>(x) << 32 | static_cast<uint32_t>(y)) * 0xC2B2AE3D27D4EB4Full;
   h ^= (static_cast<uint64_t>(iteration) << 8 | static_cast<uint64_t>(salt)) * 0x165667B19E3779F9ull;
-  h ^= h >> 33;
-  h *= 0xFF51AFD7ED558CCDull;
-  h ^= h >> 33;
-  h *= 0xC4CEB9FE1A85EC53ull;
-  h ^= h >> 33;
-  return static_cast<float>(h >> 40) / static_cast<float>(1ull << 24);
+  return UnitFloat(MixBits(h));
 }
 
 Eigen::Matrix3d Intrinsics(const Camera& camera) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/hash.h"
+
 namespace parallax {
 namespace {
 
@@ -12,12 +14,7 @@ float LatticeValue(int64_t x, int64_t y, int64_t z, uint32_t seed) {
   h ^= static_cast<uint64_t>(y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
   h ^= static_cast<uint64_t>(z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
   h ^= static_cast<uint64_t>(seed) * 0x27D4EB2F165667C5ull;
-  h ^= h >> 33;
-  h *= 0xFF51AFD7ED558CCDull;
-  h ^= h >> 33;
-  h *= 0xC4CEB9FE1A85EC53ull;
-  h ^= h >> 33;
-  return static_cast<float>(h >> 40) / static_cast<float>(1ull << 24);
+  return UnitFloat(MixBits(h));
 }
 
 // Pushes noise (centred on 0.5, spread ~0.1) towards 0 and 1 by `contrast` (the slope at
