@@ -57,7 +57,7 @@ struct PatchMatchOptions {
   double min_depth = 0.1;
   double max_depth = 100;
   // Normals more oblique than this to the viewing ray (degrees) are not proposed.
-  double max_normal_angle_deg = 80;
+  double max_normal_angle_deg = 87;
   uint32_t seed = 1;
   void Check() const;  // Throws std::invalid_argument naming the field.
 };
