@@ -12,7 +12,7 @@ struct GeometricFilterOptions {
   // Round trip reference -> source depth -> reference must land within this many pixels ...
   double max_reprojection_px = 1.0;
   // ... at a depth within this relative difference.
-  double max_relative_depth = 0.01;
+  double max_relative_depth = 0.02;
   // Views that must agree for a depth to be kept.
   int min_consistent_views = 1;
   // Full confidence needs a 1% depth change to move the point at least this many pixels in

@@ -68,8 +68,8 @@ MvsOptions MvsOptionsFor(Quality quality) {
     case Quality::kBest:
       // Measured: a larger window (5x5 samples) or two agreeing views lower completeness more
       // than they lower the error; more sources and sweeps do not.
-      options.views.max_sources = 5;
-      options.patch_match.iterations = 5;
+      options.views.max_sources = 6;
+      options.patch_match.iterations = 4;
       break;
   }
   return options;

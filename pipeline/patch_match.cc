@@ -181,7 +181,7 @@ class PatchMatcher {
         inverse_min_(static_cast<float>(1 / options.max_depth)),
         inverse_max_(static_cast<float>(1 / options.min_depth)),
         min_cos_normal_(static_cast<float>(std::cos(options.max_normal_angle_deg * std::numbers::pi / 180))),
-        best_views_(std::max<int>(1, static_cast<int>(std::ceil(sources.size() * options.best_view_fraction)))) {
+        best_views_(std::min(options.best_views, static_cast<int>(sources.size()))) {
     const Eigen::Matrix3d k_ref = Intrinsics(reference.camera);
     k_ref_inverse_ = k_ref.inverse().cast<float>();
     for (const StereoView* source : sources) {
@@ -470,7 +470,7 @@ void PatchMatchOptions::Check() const {
   require((far_neighbour_offset >= 0 && far_neighbour_offset % 2 == 1) || far_neighbour_offset == 0,
           "far_neighbour_offset must be 0 or odd (red-black propagation)");
   require(sigma_color > 0 && sigma_spatial_px > 0, "sigma_color and sigma_spatial_px must be > 0");
-  require(best_view_fraction > 0 && best_view_fraction <= 1, "best_view_fraction must be in (0, 1]");
+  require(best_views >= 1, "best_views must be >= 1");
   require(min_texture_std > 0, "min_texture_std must be > 0");
   require(max_cost > 0 && max_cost <= 2, "max_cost must be in (0, 2]");
   require(min_depth > 0 && max_depth > min_depth && std::isfinite(max_depth),

@@ -1,7 +1,7 @@
 #pragma once
 // Slanted-plane PatchMatch stereo on the CPU: per reference pixel a plane (depth + normal),
 // scored by bilaterally weighted NCC against several source views, with occlusion-aware
-// aggregation (the mean of the best views' costs, so one occluded view cannot veto a pixel).
+// aggregation (the mean of the best views' costs, so occluded views cannot veto a pixel).
 // Red-black propagation (neighbours' planes as candidates) and random refinement, the
 // random search sampled in inverse depth.
 //
@@ -47,8 +47,10 @@ struct PatchMatchOptions {
   // in pixels.
   float sigma_color = 0.12f;
   float sigma_spatial_px = 3.0f;
-  // The aggregated cost is the mean of the best ceil(views * best_view_fraction) view costs.
-  float best_view_fraction = 0.5f;
+  // The aggregated cost is the mean of this many lowest view costs (fewer if there are fewer
+  // sources). 1 measured best on a ring of cameras, where many surfaces are seen well by only
+  // the neighbour on one side: within 2% 0.83 against 0.76 with the best half of 4 views.
+  int best_views = 1;
   // Windows whose weighted standard deviation is below this are textureless: no depth.
   float min_texture_std = 0.004f;
   // Pixels whose final cost (1 - NCC, in [0, 2]) exceeds this get depth 0.
