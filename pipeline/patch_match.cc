@@ -171,8 +171,7 @@ class PatchMatcher {
   // pixels without one (depth 0) start from a random plane.
   PatchMatcher(const StereoView& reference, const std::vector<const StereoView*>& sources,
                const PatchMatchOptions& options, const DepthNormalMap* initial)
-      : reference_(reference),
-        initial_(initial),
+      : initial_(initial),
         options_(options),
         pattern_(options),
         windows_(reference.image, pattern_, options),
@@ -363,7 +362,6 @@ class PatchMatcher {
     Store(x, y, best, best_cost);
   }
 
-  const StereoView& reference_;
   const DepthNormalMap* initial_;
   const PatchMatchOptions& options_;
   WindowPattern pattern_;
