@@ -1,5 +1,6 @@
 #include "core/depth_map.h"
 
+#include <algorithm>
 #include <bit>
 #include <charconv>
 #include <cmath>
@@ -73,6 +74,28 @@ DepthMap::DepthMap(int width, int height) : width_(width), height_(height) {
                                 std::to_string(height));
   }
   values_.assign(static_cast<size_t>(width) * height, 0.0f);
+}
+
+std::optional<double> SampleDepth(const DepthMap& depth, const Eigen::Vector2d& pixel,
+                                  double max_ratio) {
+  if (!pixel.allFinite()) return std::nullopt;
+  const double fx = pixel.x() - 0.5, fy = pixel.y() - 0.5;
+  const double x0 = std::floor(fx), y0 = std::floor(fy);
+  if (x0 >= 0 && y0 >= 0 && x0 + 1 < depth.Width() && y0 + 1 < depth.Height()) {
+    const int x = static_cast<int>(x0), y = static_cast<int>(y0);
+    const double d[4] = {depth.At(x, y), depth.At(x + 1, y), depth.At(x, y + 1),
+                         depth.At(x + 1, y + 1)};
+    const auto [low, high] = std::minmax_element(d, d + 4);
+    if (*low > 0 && *high <= max_ratio * *low) {
+      const double ax = fx - x0, ay = fy - y0;
+      return 1 / ((1 - ay) * ((1 - ax) / d[0] + ax / d[1]) + ay * ((1 - ax) / d[2] + ax / d[3]));
+    }
+  }
+  const double px = std::floor(pixel.x()), py = std::floor(pixel.y());
+  if (px < 0 || py < 0 || px >= depth.Width() || py >= depth.Height()) return std::nullopt;
+  const double nearest = depth.At(static_cast<int>(px), static_cast<int>(py));
+  if (!(nearest > 0)) return std::nullopt;
+  return nearest;
 }
 
 DepthMap ReadDepthExr(const fs::path& path) {

@@ -7,7 +7,10 @@
 // (ASCII header "W&H&C&", then little-endian float32, channel-major: index (c*H + row)*W + col),
 // which also carries normal maps (3 channels).
 #include <filesystem>
+#include <optional>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace parallax {
 
@@ -30,6 +33,14 @@ class DepthMap {
   int height_ = 0;
   std::vector<float> values_;
 };
+
+// Depth at a continuous pixel position (pixel centres at +0.5): inverse depth interpolated
+// bilinearly between the four nearest pixel centres when all are valid and within `max_ratio`
+// of each other (one surface; exact on planes, where inverse depth is affine in the image),
+// else the depth of the pixel the position lies in. std::nullopt outside the map or where
+// that depth is 0.
+std::optional<double> SampleDepth(const DepthMap& depth, const Eigen::Vector2d& pixel,
+                                  double max_ratio);
 
 // A COLMAP dense array: `channels` planes of width x height floats, channel-major.
 struct DenseArray {

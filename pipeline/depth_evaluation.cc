@@ -78,29 +78,6 @@ DepthMap ReadDepthForCamera(const fs::path& path, const Camera& camera) {
   return depth;
 }
 
-// Ground-truth depth at continuous pixel coordinates `pixel`, which lie in pixel (x, y).
-// Inverse depth is affine in the image of a plane, so its bilinear interpolation is exact
-// there; depth itself is not.
-float TruthDepthAt(const DepthMap& truth, const Eigen::Vector2d& pixel, int x, int y) {
-  const double fx = pixel.x() - 0.5;
-  const double fy = pixel.y() - 0.5;
-  const int x0 = static_cast<int>(std::floor(fx));
-  const int y0 = static_cast<int>(std::floor(fy));
-  if (x0 >= 0 && y0 >= 0 && x0 + 1 < truth.Width() && y0 + 1 < truth.Height()) {
-    const std::array<double, 4> d = {truth.At(x0, y0), truth.At(x0 + 1, y0),
-                                     truth.At(x0, y0 + 1), truth.At(x0 + 1, y0 + 1)};
-    const auto [lowest, highest] = std::minmax_element(d.begin(), d.end());
-    if (*lowest > 0 && *highest <= kInterpolationMaxRatio * *lowest) {
-      const double wx = fx - x0;
-      const double wy = fy - y0;
-      const double inverse = (1 - wy) * ((1 - wx) / d[0] + wx / d[1]) +
-                             wy * ((1 - wx) / d[2] + wx / d[3]);
-      return static_cast<float>(1 / inverse);
-    }
-  }
-  return truth.At(x, y);
-}
-
 // Lifts every estimated pixel and projects it into the ground-truth camera. Rows run in
 // parallel; each writes only its own landings.
 std::vector<Landing> ProjectEstimate(const DepthMap& estimate, const Camera& estimate_camera,
@@ -125,8 +102,10 @@ std::vector<Landing> ProjectEstimate(const DepthMap& estimate, const Camera& est
         if (px < 0 || py < 0 || px >= truth.Width() || py >= truth.Height()) continue;
         const int tx = static_cast<int>(px);
         const int ty = static_cast<int>(py);
-        const float reference = TruthDepthAt(truth, *pixel, tx, ty);
-        if (!(reference > 0)) continue;  // Background in the ground truth: not comparable.
+        // Inverse depth interpolates exactly on planes; at edges the nearest pixel decides.
+        const std::optional<double> sampled = SampleDepth(truth, *pixel, kInterpolationMaxRatio);
+        if (!sampled) continue;  // Background in the ground truth: not comparable.
+        const float reference = static_cast<float>(*sampled);
         Landing& landing = landings[static_cast<size_t>(y) * estimate.Width() + x];
         landing.truth_index = static_cast<int64_t>(ty) * truth.Width() + tx;
         landing.z = static_cast<float>(point_in_truth_cam.z());

@@ -13,33 +13,6 @@ namespace {
 // Relative depth change whose image motion measures how well a depth is constrained.
 constexpr double kSensitivityStep = 0.01;
 
-// Depth of `map` at a continuous pixel position: inverse depth interpolated between the four
-// nearest pixel centres where they belong to one surface (within 5%), else the nearest pixel.
-// Sampling the nearest pixel alone would fail the 1% test on grazing surfaces, where depth
-// changes by more than that from one pixel to the next.
-std::optional<double> SampleDepth(const DepthMap& map, const Eigen::Vector2d& pixel) {
-  const double fx = pixel.x() - 0.5, fy = pixel.y() - 0.5;
-  const int x0 = static_cast<int>(std::floor(fx)), y0 = static_cast<int>(std::floor(fy));
-  const int nx = static_cast<int>(std::floor(pixel.x())), ny = static_cast<int>(std::floor(pixel.y()));
-  if (nx < 0 || ny < 0 || nx >= map.Width() || ny >= map.Height()) return std::nullopt;
-  if (x0 >= 0 && y0 >= 0 && x0 + 1 < map.Width() && y0 + 1 < map.Height()) {
-    const float corners[4] = {map.At(x0, y0), map.At(x0 + 1, y0), map.At(x0, y0 + 1),
-                              map.At(x0 + 1, y0 + 1)};
-    const auto [low, high] = std::minmax_element(corners, corners + 4);
-    if (*low > 0 && *high <= *low * 1.05f) {
-      const double ax = fx - x0, ay = fy - y0;
-      const double inverse = (1 - ax) * (1 - ay) / static_cast<double>(corners[0]) +
-                             ax * (1 - ay) / static_cast<double>(corners[1]) +
-                             (1 - ax) * ay / static_cast<double>(corners[2]) +
-                             ax * ay / static_cast<double>(corners[3]);
-      return 1 / inverse;
-    }
-  }
-  const float nearest = map.At(nx, ny);
-  if (!(nearest > 0)) return std::nullopt;
-  return static_cast<double>(nearest);
-}
-
 }  // namespace
 
 void GeometricFilterOptions::Check() const {
@@ -78,7 +51,9 @@ FilteredDepth FilterGeometric(
         const std::optional<Eigen::Vector2d> nearer =
             view->camera.Project(source_from_ref[s] * (*point * (1 - kSensitivityStep)));
         if (nearer) sensitivity_px = std::max(sensitivity_px, (*nearer - *in_source).norm());
-        const std::optional<double> source_depth = SampleDepth(map->depth, *in_source);
+        // Interpolated: sampling the nearest pixel alone would fail the agreement test on
+        // grazing surfaces, whose depth changes by more than that from pixel to pixel.
+        const std::optional<double> source_depth = SampleDepth(map->depth, *in_source, 1.05);
         if (!source_depth) continue;
         // Back from where the point landed, at the source's depth, into the reference.
         const std::optional<Eigen::Vector3d> back = view->camera.Unproject(*in_source, *source_depth);

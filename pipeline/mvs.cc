@@ -79,15 +79,7 @@ DepthMap ToColmapSampling(const DepthMap& depth) {
   DepthMap sampled(depth.Width(), depth.Height());
   for (int y = 0; y < depth.Height(); ++y) {
     for (int x = 0; x < depth.Width(); ++x) {
-      sampled.At(x, y) = depth.At(x, y);
-      if (x == 0 || y == 0) continue;
-      const float corners[4] = {depth.At(x - 1, y - 1), depth.At(x, y - 1), depth.At(x - 1, y),
-                                depth.At(x, y)};
-      const auto [low, high] = std::minmax_element(corners, corners + 4);
-      if (!(*low > 0) || *high > *low * 1.01f) continue;
-      float inverse = 0;
-      for (const float corner : corners) inverse += 0.25f / corner;
-      sampled.At(x, y) = 1 / inverse;
+      sampled.At(x, y) = static_cast<float>(SampleDepth(depth, Eigen::Vector2d(x, y), 1.01).value_or(0));
     }
   }
   return sampled;
