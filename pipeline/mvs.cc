@@ -68,7 +68,7 @@ MvsOptions MvsOptionsFor(Quality quality) {
     case Quality::kBest:
       // Measured: a larger window (5x5 samples) or requiring two agreeing views lowered
       // completeness more than the error; more sources and sweeps raise both accuracy and time.
-      options.views.max_sources = 6;
+      options.views.max_sources = 7;
       options.patch_match.iterations = 4;
       break;
   }

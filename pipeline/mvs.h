@@ -23,8 +23,8 @@ struct MvsOptions {
 };
 
 // fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
-// balanced: 4 sources, 4x4 samples, 3 iterations, near and far neighbours;
-// best: 6 sources, 4 iterations.
+// balanced: 5 sources, 4x4 samples, 3 iterations, near and far neighbours;
+// best: 7 sources, 4 iterations.
 MvsOptions MvsOptionsFor(Quality quality);
 
 struct MvsViewReport {

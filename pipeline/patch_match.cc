@@ -302,21 +302,15 @@ class PatchMatcher {
 
   void Initialise(int x, int y) {
     if (!Textured(x, y)) return;  // Stays at depth 0, cost 2.
-    const Plane random{RandomDepth(x, y, -1, 0), RandomNormal(x, y, -1, 1)};
     if (initial_ && initial_->depth.At(x, y) > 0) {
       const size_t i = Index(x, y);
       const Plane proposed{initial_->depth.At(x, y), Eigen::Vector3f(&initial_->normal[3 * i])};
       if (Acceptable(x, y, proposed)) {
-        const float proposed_cost = Cost(x, y, proposed);
-        const float random_cost = Cost(x, y, random);
-        if (proposed_cost <= random_cost) {
-          Store(x, y, proposed, proposed_cost);
-        } else {
-          Store(x, y, random, random_cost);
-        }
+        Store(x, y, proposed, Cost(x, y, proposed));
         return;
       }
     }
+    const Plane random{RandomDepth(x, y, -1, 0), RandomNormal(x, y, -1, 1)};
     Store(x, y, random, Cost(x, y, random));
   }
 
@@ -358,7 +352,9 @@ class PatchMatcher {
     const Eigen::Vector3f tilted =
         (best.normal + amplitude * RandomNormal(x, y, iteration, 30)).normalized();
     consider({best.depth, tilted});
-    consider({RandomDepth(x, y, iteration, 40), RandomNormal(x, y, iteration, 50)});
+    // A fresh random plane helps where nothing good has arrived yet; below the coarsest
+    // level the pyramid has already proposed one, and this is wasted work.
+    if (!initial_) consider({RandomDepth(x, y, iteration, 40), RandomNormal(x, y, iteration, 50)});
     Store(x, y, best, best_cost);
   }
 

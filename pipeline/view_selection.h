@@ -11,7 +11,7 @@ namespace parallax {
 
 struct ViewSelectionOptions {
   // Source views per reference view.
-  int max_sources = 4;
+  int max_sources = 5;
   // A pair needs this many shared 3D points to be considered.
   int min_shared_points = 10;
   // Triangulation angles below this (degrees) count proportionally less: small baselines
