@@ -10,7 +10,7 @@ namespace parallax {
 
 struct GeometricFilterOptions {
   // Round trip reference -> source depth -> reference must land within this many pixels ...
-  double max_reprojection_px = 1.0;
+  double max_reprojection_px = 2.0;
   // ... at a depth within this relative difference.
   double max_relative_depth = 0.02;
   // Views that must agree for a depth to be kept.

@@ -74,7 +74,7 @@ uint64_t HashFolder(const fs::path& dir) {
 }
 
 // Bump when the depth stage's results change for the same options, so caches recompute.
-constexpr const char* kMvsVersion = "patch-match-4";
+constexpr const char* kMvsVersion = "patch-match-5";
 constexpr const char* kFusionVersion = "fusion-1";
 
 nlohmann::json MvsSummaryJson(const MvsSummary& mvs) {
