@@ -46,6 +46,11 @@ void PlausibilityOptions::Check() const {
   if (min_points_per_image < 1) throw std::invalid_argument("min_points_per_image must be >= 1");
 }
 
+double PrincipalPointOffset(const Camera& camera) {
+  return std::max(std::abs(camera.PrincipalX() / static_cast<double>(camera.width) - 0.5),
+                  std::abs(camera.PrincipalY() / static_cast<double>(camera.height) - 0.5));
+}
+
 std::vector<double> TriangulationAnglesDeg(const SparseModel& model) {
   std::unordered_map<uint32_t, Eigen::Vector3d> centers;
   for (const SparseImage& image : model.Images()) {
@@ -93,12 +98,11 @@ PlausibilityReport CheckPlausibility(const SparseModel& model, double focal_prio
   }
 
   for (const Camera& camera : model.Cameras()) {
-    const double dx = std::abs(camera.PrincipalX() / static_cast<double>(camera.width) - 0.5);
-    const double dy = std::abs(camera.PrincipalY() / static_cast<double>(camera.height) - 0.5);
-    if (std::max(dx, dy) > options.max_principal_point_offset) {
+    const double offset = PrincipalPointOffset(camera);
+    if (offset > options.max_principal_point_offset) {
       report.problems.push_back(Format(
           "camera %u: principal point (%.1f, %.1f) is %.0f%% of the image size off-centre",
-          camera.id, camera.PrincipalX(), camera.PrincipalY(), 100 * std::max(dx, dy)));
+          camera.id, camera.PrincipalX(), camera.PrincipalY(), 100 * offset));
     }
   }
 

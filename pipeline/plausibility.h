@@ -47,6 +47,10 @@ PlausibilityReport CheckPlausibility(const SparseModel& model, double focal_prio
                                      bool prior_from_exif,
                                      const PlausibilityOptions& options = {});
 
+// How far the principal point lies from the image centre, as the larger of its x and y
+// offsets divided by the image width and height (0 = centred, 0.5 = on the border).
+double PrincipalPointOffset(const Camera& camera);
+
 // Largest angle (degrees) between the rays from the observing cameras to each 3D point, in
 // the order of model.Points3D(). Long tracks use their first 16 observations.
 std::vector<double> TriangulationAnglesDeg(const SparseModel& model);

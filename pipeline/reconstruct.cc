@@ -229,9 +229,7 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const WorkspacePaths& pat
   const SparseModel model = ReadSparseModel(refined);
   double worst_offset = 0;
   for (const Camera& camera : model.Cameras()) {
-    worst_offset = std::max(
-        {worst_offset, std::abs(camera.PrincipalX() / static_cast<double>(camera.width) - 0.5),
-         std::abs(camera.PrincipalY() / static_cast<double>(camera.height) - 0.5)});
+    worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
   }
   char note[160];
   if (worst_offset > options.max_refined_principal_point_offset) {
@@ -248,7 +246,8 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const WorkspacePaths& pat
   return note;
 }
 
-SparseModel LargestModel(const fs::path& models_dir, int& other_models) {
+// The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
+std::vector<fs::path> ModelDirs(const fs::path& models_dir) {
   std::vector<fs::path> dirs;
   for (const auto& entry : fs::directory_iterator(models_dir)) {
     if (entry.is_directory() && DetectSparseFormat(entry.path())) dirs.push_back(entry.path());
@@ -259,12 +258,16 @@ SparseModel LargestModel(const fs::path& models_dir, int& other_models) {
                         (models_dir.parent_path().parent_path() / "logs" / "mapper.log").string());
   }
   std::sort(dirs.begin(), dirs.end());
+  return dirs;
+}
+
+// The model with the most registered images (the first of equals).
+SparseModel LargestModel(const std::vector<fs::path>& dirs) {
   SparseModel best;
   for (const fs::path& dir : dirs) {
     SparseModel model = ReadSparseModel(dir);
     if (model.Images().size() > best.Images().size()) best = std::move(model);
   }
-  other_models = static_cast<int>(dirs.size()) - 1;
   return best;
 }
 
@@ -522,8 +525,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                  progress);
     }
     Replace(models, paths.Models());
-    int other_models = 0;
-    WriteSparseModel(LargestModel(paths.Models(), other_models), paths.RawModel(),
+    WriteSparseModel(LargestModel(ModelDirs(paths.Models())), paths.RawModel(),
                      SparseFormat::kBinary);
     if (refine_principal_point) {
       summary.notes.push_back(RefinePrincipalPoint(colmap, paths, options, progress));
@@ -537,7 +539,8 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   }
 
   const SparseModel raw_model = ReadSparseModel(paths.RawModel());
-  LargestModel(paths.Models(), summary.other_models);
+  // Counting the folders is enough here: the largest model was chosen when mapping.
+  summary.other_models = static_cast<int>(ModelDirs(paths.Models()).size()) - 1;
   if (summary.other_models > 0) {
     summary.warnings.push_back(
         "COLMAP split the photos into " + std::to_string(summary.other_models + 1) +
