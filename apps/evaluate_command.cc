@@ -11,7 +11,9 @@
 #include "pipeline/depth_evaluation.h"
 #include "pipeline/cloud_evaluation.h"
 #include "pipeline/evaluate.h"
-#include "pipeline/fusion.h"
+#include "pipeline/mesh_evaluation.h"
+#include "pipeline/ply.h"
+#include "pipeline/textured_mesh.h"
 
 namespace parallax {
 namespace {
@@ -69,6 +71,30 @@ nlohmann::json ReconstructTimings(const std::filesystem::path& workspace) {
   } catch (const std::exception&) {
     return nullptr;
   }
+}
+
+// The textured mesh: its vertices against the ground-truth depth (like the fused cloud), and
+// its renders from the workspace cameras against the photos.
+nlohmann::json EvaluateMesh(const std::filesystem::path& obj, const SparseModel& estimate,
+                            const std::filesystem::path& workspace, const SparseModel& truth,
+                            const SceneFolder& scene, const Similarity3d& truth_from_estimate) {
+  const TexturedMesh mesh = ReadTexturedMesh(obj);
+  const CloudAccuracy accuracy =
+      MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
+  const std::filesystem::path render_dir = workspace / "evaluation" / "mesh_render";
+  const TexturedMeshScore texture =
+      ScoreTexturedMesh(mesh, estimate, workspace / "images", render_dir);
+  std::printf("mesh: %zu triangles; vertices: median relative distance %.3f%%, within 1%% "
+              "%.1f%%; textured renders: %.2f dB PSNR on %.1f%% covered pixels (%s)\n",
+              mesh.triangles.size(), 100 * accuracy.median_relative_distance,
+              100 * accuracy.within_1pct, texture.psnr_mean, 100 * texture.coverage_mean,
+              render_dir.string().c_str());
+  return {{"triangles", mesh.triangles.size()},
+          {"vertices", mesh.vertices.size()},
+          {"median_relative_distance", accuracy.median_relative_distance},
+          {"within_1pct", accuracy.within_1pct},
+          {"textured_psnr_mean", texture.psnr_mean},
+          {"textured_coverage_mean", texture.coverage_mean}};
 }
 
 }  // namespace
@@ -130,7 +156,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     const std::filesystem::path fused = arguments->workspace / "fused.ply";
     if (std::filesystem::exists(fused)) {
       const CloudAccuracy cloud = MeasureCloud(
-          ReadPlyPositions(fused), truth, scene.Training().depth,
+          ReadPly(fused).vertices, truth, scene.Training().depth,
           arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source);
       std::printf("fused cloud: %zu points, %zu on ground-truth surfaces; median relative "
                   "distance %.3f%%, within 1%% %.1f%%\n",
@@ -140,6 +166,12 @@ void RegisterEvaluateCommand(CLI::App& app) {
                        {"measured", cloud.measured},
                        {"median_relative_distance", cloud.median_relative_distance},
                        {"within_1pct", cloud.within_1pct}};
+    }
+    const std::filesystem::path mesh_obj = arguments->workspace / "mesh" / "mesh.obj";
+    if (std::filesystem::exists(mesh_obj)) {
+      json["mesh"] = EvaluateMesh(mesh_obj, estimate, arguments->workspace, truth, scene,
+                                  arguments->no_align ? Similarity3d{}
+                                                      : evaluation.alignment.target_from_source);
     }
     const nlohmann::json timings = ReconstructTimings(arguments->workspace);
     if (!timings.is_null()) json["timings_s"] = timings;

@@ -63,6 +63,7 @@ void RegisterReconstructCommand(CLI::App& app) {
     std::string intrinsics;
     std::string camera_model = "SIMPLE_RADIAL";
     bool no_depth = false;
+    bool no_mesh = false;
     ReconstructOptions options;
   };
   auto arguments = std::make_shared<Arguments>();
@@ -98,6 +99,8 @@ void RegisterReconstructCommand(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   command->add_flag("--no-depth", arguments->no_depth,
                     "stop after structure from motion (no multi-view stereo)");
+  command->add_flag("--no-mesh", arguments->no_mesh,
+                    "stop after depth maps and the fused cloud (no textured mesh)");
   command->add_flag("--strict", arguments->options.strict,
                     "an implausible reconstruction is an error (exit 2), not a warning");
   command->add_flag("--dry-run", arguments->options.dry_run,
@@ -108,6 +111,7 @@ void RegisterReconstructCommand(CLI::App& app) {
     ReconstructOptions options = arguments->options;
     options.camera_model = CameraModelFromName(arguments->camera_model);
     options.estimate_depth = !arguments->no_depth;
+    options.build_mesh = !arguments->no_depth && !arguments->no_mesh;
     if (!arguments->intrinsics.empty()) options.intrinsics = ParseIntrinsics(arguments->intrinsics);
     ReconstructSummary summary;
     {

@@ -2,9 +2,7 @@
 
 #include <cmath>
 #include <cstring>
-#include <map>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 
 #include "core/atomic_file.h"
@@ -148,53 +146,6 @@ void WritePly(const fs::path& path, const std::vector<FusedPoint>& points) {
     out += kVertexBytes;
   }
   WriteFileAtomically(path, bytes);
-}
-
-std::vector<Eigen::Vector3f> ReadPlyPositions(const fs::path& path) {
-  const std::string bytes = ReadFileBytes(path);
-  const size_t end = bytes.find("end_header\n");
-  if (!bytes.starts_with("ply\n") || end == std::string::npos) {
-    throw BadInputError(path.string() + ": not a PLY file");
-  }
-  std::istringstream header(bytes.substr(0, end));
-  size_t count = 0, stride = 0;
-  bool in_vertex = false, little_endian = false;
-  std::vector<std::string> properties;
-  for (std::string line; std::getline(header, line);) {
-    std::istringstream words(line);
-    std::string keyword;
-    words >> keyword;
-    if (keyword == "format") {
-      std::string format;
-      words >> format;
-      little_endian = format == "binary_little_endian";
-    } else if (keyword == "element") {
-      std::string name;
-      words >> name;
-      in_vertex = name == "vertex";
-      if (in_vertex) words >> count;
-    } else if (keyword == "property" && in_vertex) {
-      std::string type, name;
-      words >> type >> name;
-      const std::map<std::string, size_t> sizes = {{"float", 4}, {"uchar", 1}, {"double", 8},
-                                                    {"int", 4}, {"uint", 4}, {"short", 2},
-                                                    {"ushort", 2}, {"char", 1}};
-      if (!sizes.count(type)) throw BadInputError(path.string() + ": unsupported property type " + type);
-      stride += sizes.at(type);
-      properties.push_back(type + " " + name);
-    }
-  }
-  if (!little_endian || properties.size() < 3 || properties[0] != "float x" ||
-      properties[1] != "float y" || properties[2] != "float z") {
-    throw BadInputError(path.string() + ": expected a binary little-endian PLY with float x y z");
-  }
-  const size_t data = end + std::string("end_header\n").size();
-  if (stride == 0 || (bytes.size() - data) / stride < count) {
-    throw BadInputError(path.string() + ": " + std::to_string(count) + " vertices announced, file is shorter");
-  }
-  std::vector<Eigen::Vector3f> positions(count);
-  for (size_t i = 0; i < count; ++i) std::memcpy(positions[i].data(), bytes.data() + data + i * stride, 12);
-  return positions;
 }
 
 }  // namespace parallax

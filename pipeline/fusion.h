@@ -39,8 +39,4 @@ std::vector<FusedPoint> FuseWorkspace(const std::filesystem::path& workspace,
 // atomically. The format COLMAP's fused.ply uses.
 void WritePly(const std::filesystem::path& path, const std::vector<FusedPoint>& points);
 
-// Reads the vertex positions of a binary little-endian PLY whose vertex element starts with
-// float x, y, z (ours and COLMAP's). Throws BadInputError naming the file otherwise.
-std::vector<Eigen::Vector3f> ReadPlyPositions(const std::filesystem::path& path);
-
 }  // namespace parallax

@@ -15,6 +15,7 @@
 #include "pipeline/colmap.h"
 #include "pipeline/colmap_database.h"
 #include "pipeline/fusion.h"
+#include "pipeline/mesh.h"
 #include "pipeline/mvs.h"
 #include "pipeline/stage_cache.h"
 
@@ -76,6 +77,16 @@ uint64_t HashFolder(const fs::path& dir) {
 // Bump when the depth stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-5";
 constexpr const char* kFusionVersion = "fusion-1";
+constexpr const char* kMeshVersion = "mesh-1";
+
+nlohmann::json MeshSummaryJson(const MeshSummary& mesh) {
+  return {{"poisson_triangles", mesh.poisson_triangles},
+          {"triangles", mesh.triangles},
+          {"vertices", mesh.vertices},
+          {"texels_per_edge", mesh.texels_per_edge},
+          {"untextured_triangles", mesh.untextured_triangles},
+          {"atlas_size", {mesh.atlas_width, mesh.atlas_height}}};
+}
 
 nlohmann::json MvsSummaryJson(const MvsSummary& mvs) {
   nlohmann::json views = nlohmann::json::array();
@@ -322,6 +333,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
             {"well_constrained_image_share", plausibility.well_constrained_image_share},
             {"problems", plausibility.problems}}},
           {"depth", summary.depth_views},
+          {"mesh", summary.mesh},
           {"notes", summary.notes},
           {"warnings", summary.warnings}};
 }
@@ -615,6 +627,24 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     stages.Run("fusion", Hasher().Add(depth_key).Add(kFusionVersion).Hex(), fused, [&] {
       WritePly(fused, FuseWorkspace(workspace, {}, progress));
     });
+
+    if (options.build_mesh) {
+      const fs::path mesh_file = workspace / "mesh" / "summary.json";
+      const std::string mesh_key = Hasher()
+                                       .Add(depth_key)
+                                       .Add(kFusionVersion)
+                                       .Add(kMeshVersion)
+                                       .Add(static_cast<uint64_t>(options.quality))
+                                       .Hex();
+      stages.Run("mesh", mesh_key, mesh_file, [&] {
+        const MeshSummary mesh =
+            MeshWorkspace(workspace, colmap, MeshOptionsFor(options.quality), progress);
+        WriteFileAtomically(mesh_file, MeshSummaryJson(mesh).dump(2) + "\n");
+      });
+      summary.mesh = nlohmann::json::parse(ReadFileBytes(mesh_file));
+    } else {
+      summary.notes.push_back("mesh: not built (--no-mesh)");
+    }
   }
   WriteReport(paths.Report(), summary);
   return summary;

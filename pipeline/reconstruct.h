@@ -56,6 +56,8 @@ struct ReconstructOptions {
   PlausibilityOptions plausibility;
   // Run multi-view stereo after SfM (pipeline/mvs.h), at `quality`.
   bool estimate_depth = true;
+  // After depth: Poisson mesh, trimmed and textured (pipeline/mesh.h).
+  bool build_mesh = true;
   void Check() const;  // Throws std::invalid_argument naming the field.
 };
 
@@ -82,6 +84,7 @@ struct ReconstructSummary {
   // Multi-view stereo per view: source views chosen, depth range, valid shares (JSON, as
   // written to <ws>/depth/views.json); null when depth was not estimated.
   nlohmann::json depth_views;
+  nlohmann::json mesh;  // pipeline/mesh.h's MeshSummary; null when no mesh was built.
   std::vector<std::string> notes;  // Decisions worth knowing (e.g. a refinement kept or not).
   std::vector<std::string> warnings;
 };

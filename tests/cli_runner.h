@@ -12,12 +12,10 @@ struct CliResult {
   std::string output;
 };
 
-// `arguments` is appended to the executable as shell words (quote paths with spaces).
-inline CliResult RunParallax(const std::string& arguments, const std::string& environment = "") {
-  const std::string command =
-      environment + " '" + std::string(PARALLAX_EXECUTABLE) + "' " + arguments + " 2>&1";
+// Runs a shell command line, capturing stdout and stderr together.
+inline CliResult RunCommand(const std::string& command) {
   CliResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
   if (!pipe) return result;
   std::array<char, 4096> buffer;
   size_t count;
@@ -27,6 +25,11 @@ inline CliResult RunParallax(const std::string& arguments, const std::string& en
   const int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// `arguments` is appended to the executable as shell words (quote paths with spaces).
+inline CliResult RunParallax(const std::string& arguments, const std::string& environment = "") {
+  return RunCommand(environment + " '" + std::string(PARALLAX_EXECUTABLE) + "' " + arguments);
 }
 
 inline std::string Quote(const std::string& path) { return "'" + path + "'"; }

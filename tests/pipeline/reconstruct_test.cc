@@ -11,6 +11,10 @@
 #include "pipeline/cloud_evaluation.h"
 #include "pipeline/colmap.h"
 #include "pipeline/fusion.h"
+#include "pipeline/mesh_evaluation.h"
+#include "pipeline/ply.h"
+#include "pipeline/textured_mesh.h"
+#include "tests/cli_runner.h"
 #include "pipeline/depth_evaluation.h"
 #include "pipeline/evaluate.h"
 #include "tests/temp_dir.h"
@@ -98,7 +102,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
 
   // Our fusion, and COLMAP's own stereo_fusion run on our dense workspace: COLMAP accepts it,
   // and both clouds lie on the true surfaces.
-  const CloudAccuracy ours = MeasureCloud(ReadPlyPositions(workspace.Path() / "fused.ply"), truth,
+  const CloudAccuracy ours = MeasureCloud(ReadPly(workspace.Path() / "fused.ply").vertices, truth,
                                           scene.Training().depth, {});
   EXPECT_GT(ours.points, 50000u);
   EXPECT_LT(ours.median_relative_distance, 0.005);
@@ -109,10 +113,29 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
                 "--input_type", "geometric", "--output_path", colmap_ply.string()},
                workspace.Path() / "logs" / "stereo_fusion.log", "stereo_fusion", 0, progress);
   const CloudAccuracy theirs =
-      MeasureCloud(ReadPlyPositions(colmap_ply), truth, scene.Training().depth, {});
+      MeasureCloud(ReadPly(colmap_ply).vertices, truth, scene.Training().depth, {});
   EXPECT_GT(theirs.points, ours.points / 20);  // COLMAP keeps points seen by 5+ views; we 2+.
   EXPECT_LT(theirs.median_relative_distance, 0.005);
   EXPECT_GT(theirs.within_1pct, 0.9);
+
+  // The textured mesh: on the true surfaces, readable by a standard tool, and its renders
+  // reproduce the photos.
+  const std::filesystem::path obj = workspace.Path() / "mesh" / "mesh.obj";
+  const TexturedMesh mesh = ReadTexturedMesh(obj);
+  EXPECT_GT(mesh.triangles.size(), 5000u);
+  const CloudAccuracy vertices = MeasureCloud(mesh.vertices, truth, scene.Training().depth, {});
+  EXPECT_LT(vertices.median_relative_distance, 0.005);
+  EXPECT_GT(vertices.within_1pct, 0.8);
+  const TexturedMeshScore texture =
+      ScoreTexturedMesh(mesh, model, workspace.Path() / "images", {});
+  EXPECT_EQ(texture.views, 12);
+  EXPECT_GE(texture.psnr_mean, 25);
+  EXPECT_GT(texture.coverage_mean, 0.5);
+  const CliResult assimp = RunCommand("assimp info " + Quote(obj.string()));
+  EXPECT_EQ(assimp.exit_code, 0) << assimp.output;
+  EXPECT_NE(assimp.output.find("Faces:"), std::string::npos) << assimp.output;
+  EXPECT_NE(assimp.output.find(std::to_string(mesh.triangles.size())), std::string::npos)
+      << assimp.output;
 }
 
 TEST(Colmap, AFailingCommandNamesTheToolStatusAndLog) {
