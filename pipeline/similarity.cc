@@ -447,6 +447,15 @@ Rigid3d Similarity3d::TransformPose(const Rigid3d& cam_from_source) const {
   return Rigid3d(cam_from_target_rotation, -(cam_from_target_rotation * centre_in_target));
 }
 
+Similarity3d Similarity3d::Inverse() const {
+  // x = s R y + t  <=>  y = (1/s) R^T x - (1/s) R^T t.
+  Similarity3d inverse;
+  inverse.scale = 1 / scale;
+  inverse.rotation = rotation.conjugate();
+  inverse.translation = -(inverse.scale * (inverse.rotation * translation));
+  return inverse;
+}
+
 void AlignmentOptions::Check() const {
   const std::pair<const char*, double> fields[] = {
       {"inlier_center_fraction", inlier_center_fraction},

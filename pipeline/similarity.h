@@ -20,6 +20,8 @@ struct Similarity3d {
   }
   // The pose of a camera whose source-frame pose is `cam_from_source`, in the target frame.
   Rigid3d TransformPose(const Rigid3d& cam_from_source) const;
+  // The similarity taking the target frame back to the source frame.
+  Similarity3d Inverse() const;
 };
 
 struct AlignmentOptions {

@@ -371,3 +371,23 @@ TEST(AlignmentOptions, CheckRejectsNonPositiveOrNonFiniteFields) {
 
 }  // namespace
 }  // namespace parallax
+
+namespace parallax {
+namespace {
+
+TEST(Similarity3d, InverseUndoesPointsAndPoses) {
+  Similarity3d similarity;
+  similarity.scale = 3.5;
+  similarity.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  similarity.translation = Eigen::Vector3d(-4, 5, 0.25);
+  const Similarity3d inverse = similarity.Inverse();
+  const Eigen::Vector3d point(1.5, -2, 7);
+  EXPECT_LT((inverse * (similarity * point) - point).norm(), 1e-12);
+  const Rigid3d pose = LookAt({1, 2, 3}, {0, 0, 0}, {0, 0, 1});
+  const Rigid3d back = inverse.TransformPose(similarity.TransformPose(pose));
+  EXPECT_LT(RotationAngleDeg(back.rotation, pose.rotation), 1e-9);
+  EXPECT_LT((CameraCenter(back) - CameraCenter(pose)).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace parallax

@@ -1,0 +1,113 @@
+// No data lost: `parallax reconstruct` killed with SIGKILL in the middle of a stage leaves no
+// truncated file under a final name, and a re-run completes, redoing only what was cut short.
+#include <csignal>
+#include <chrono>
+#include <map>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/atomic_file.h"
+#include "core/depth_map.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
+#include "tests/cli_runner.h"
+#include "tests/temp_dir.h"
+
+extern char** environ;
+
+namespace parallax {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
+
+size_t CountFiles(const fs::path& dir, const std::string& extension) {
+  if (!fs::is_directory(dir)) return 0;
+  size_t count = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    count += entry.path().extension() == extension && entry.path().string().find(".tmp") == std::string::npos;
+  }
+  return count;
+}
+
+// Every file under a final name reads back whole in its format.
+void ExpectEveryFileComplete(const fs::path& workspace) {
+  for (const auto& entry : fs::recursive_directory_iterator(workspace)) {
+    if (!entry.is_regular_file()) continue;
+    const fs::path& path = entry.path();
+    if (path.string().find(".tmp") != std::string::npos) continue;  // Not a final name.
+    const std::string extension = path.extension().string();
+    SCOPED_TRACE(path.string());
+    if (extension == ".exr" || extension == ".png") {
+      EXPECT_NO_THROW(ReadImage(path));
+    } else if (extension == ".json") {
+      EXPECT_TRUE(nlohmann::json::accept(ReadFileBytes(path)));
+    } else if (extension == ".bin" && path.parent_path().parent_path().filename() == "stereo") {
+      EXPECT_NO_THROW(ReadColmapArray(path));
+    }
+  }
+  if (fs::exists(workspace / "sparse" / "images.bin")) {
+    EXPECT_NO_THROW(ReadSparseModel(workspace / "sparse"));
+  }
+}
+
+TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
+  const TempDir dir;
+  const fs::path workspace = dir.Path() / "ws";
+  const std::string executable = PARALLAX_EXECUTABLE;
+  const std::string photos = kSmallImages.string(), ws = workspace.string();
+  const char* argv[] = {executable.c_str(), "reconstruct", photos.c_str(), ws.c_str(),
+                        "--no-mesh", nullptr};
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  // Its own process group, so the kill also reaches a running colmap.
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, executable.c_str(), nullptr, &attributes,
+                        const_cast<char* const*>(argv), environ), 0);
+  posix_spawnattr_destroy(&attributes);
+
+  // Kill once the depth stage has written some of its 12 maps, not all.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(3);
+  bool mid_depth = false;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const size_t maps = CountFiles(workspace / "depth", ".exr");
+    if (maps >= 2 && CountFiles(workspace / "depth", ".json") == 0) {
+      mid_depth = true;
+      break;
+    }
+    int status = 0;
+    if (waitpid(pid, &status, WNOHANG) == pid) break;  // Finished early: nothing to kill.
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(-pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  ASSERT_TRUE(mid_depth) << "the depth stage was never caught half-done";
+  const std::string stages = ReadFileBytes(workspace / "stages.json");
+  EXPECT_EQ(stages.find("\"depth\""), std::string::npos) << "an interrupted stage is not done";
+  ExpectEveryFileComplete(workspace);
+
+  const CliResult rerun = RunParallax("reconstruct " + Quote(photos) + " " + Quote(ws) + " --no-mesh");
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
+  // SfM stages were complete and are skipped; the depth stage runs again.
+  const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(workspace / "report.json"));
+  std::map<std::string, bool> skipped;
+  for (const nlohmann::json& stage : report.at("reconstruct").at("stages")) {
+    skipped[stage.at("name").get<std::string>()] = stage.at("skipped").get<bool>();
+  }
+  EXPECT_TRUE(skipped.at("mapper"));
+  EXPECT_TRUE(skipped.at("undistort"));
+  EXPECT_FALSE(skipped.at("depth"));
+  EXPECT_EQ(CountFiles(workspace / "depth", ".exr"), 24u);  // Depth + confidence per view.
+  ExpectEveryFileComplete(workspace);
+}
+
+}  // namespace
+}  // namespace parallax
