@@ -8,6 +8,7 @@ namespace parallax {
 void RegisterSynthCommand(CLI::App& app);
 void RegisterReconstructCommand(CLI::App& app);
 void RegisterEvaluateCommand(CLI::App& app);
+void RegisterRenderCommand(CLI::App& app);
 
 // A subcommand whose stage has not been built yet: it says so and exits with code 1.
 void RegisterPendingCommand(CLI::App& app, const std::string& name,

@@ -14,6 +14,7 @@
 #include "pipeline/mesh_evaluation.h"
 #include "pipeline/ply.h"
 #include "pipeline/textured_mesh.h"
+#include "reproject/novel_evaluation.h"
 
 namespace parallax {
 namespace {
@@ -97,6 +98,49 @@ nlohmann::json EvaluateMesh(const std::filesystem::path& obj, const SparseModel&
           {"textured_coverage_mean", texture.coverage_mean}};
 }
 
+// The scene's novel cameras rendered from the workspace (cameras mapped into its frame) or,
+// with gt_sources, from the scene's own training views and depth; compared with the novel
+// images.
+nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::path& workspace,
+                             bool gt_sources, const Similarity3d& truth_from_estimate) {
+  const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
+  const Similarity3d estimate_from_truth =
+      gt_sources ? Similarity3d{} : truth_from_estimate.Inverse();
+  std::vector<NamedCamera> targets;
+  std::vector<std::string> names;
+  for (const SparseImage& image : novel.Images()) {
+    targets.push_back({std::filesystem::path(image.name).stem().string(),
+                       {novel.CameraById(image.camera_id),
+                        estimate_from_truth.TransformPose(image.cam_from_world)}});
+    names.push_back(image.name);
+  }
+  SourceLibrary library(gt_sources ? scene.Training() : SourcePathsFor(workspace));
+  const std::filesystem::path comparison_dir =
+      workspace / "evaluation" / (gt_sources ? "novel_gt_sources" : "novel");
+  const NovelEvaluation result = EvaluateNovelViews(library, targets, names, scene.Novel(), {},
+                                                    {}, comparison_dir);
+  std::printf("novel views (%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels), SSIM %.3f; "
+              "holes %.2f%% (cracks %.2f%%) -> %.2f%% after filling; out of view %.2f%%, "
+              "background %.2f%%; %.1f ms per view; %d of %d sources loaded (%s)\n",
+              gt_sources ? "ground-truth sources" : "workspace sources", result.views,
+              result.psnr_mean, result.psnr_valid_mean, result.ssim_mean,
+              100 * result.hole_ratio_mean, 100 * result.crack_ratio_mean,
+              100 * result.hole_ratio_filled_mean, 100 * result.out_of_view_ratio_mean,
+              100 * result.background_ratio_mean, result.ms_per_view, result.sources_loaded,
+              result.sources_total, comparison_dir.string().c_str());
+  return {{"views", result.views},
+          {"psnr_mean", result.psnr_mean},
+          {"ssim_mean", result.ssim_mean},
+          {"psnr_valid_mean", result.psnr_valid_mean},
+          {"hole_ratio_mean", result.hole_ratio_mean},
+          {"crack_ratio_mean", result.crack_ratio_mean},
+          {"out_of_view_ratio_mean", result.out_of_view_ratio_mean},
+          {"background_ratio_mean", result.background_ratio_mean},
+          {"hole_ratio_filled_mean", result.hole_ratio_filled_mean},
+          {"ms_per_view", result.ms_per_view},
+          {"gt_sources", gt_sources}};
+}
+
 }  // namespace
 
 void RegisterEvaluateCommand(CLI::App& app) {
@@ -105,6 +149,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     std::filesystem::path scene;
     std::filesystem::path json;
     bool no_align = false;
+    bool gt_sources = false;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -122,6 +167,9 @@ void RegisterEvaluateCommand(CLI::App& app) {
   command->add_flag("--no-align", arguments->no_align,
                     "compare depth without the estimated alignment (identity): for workspaces "
                     "made with reconstruct --known-cameras, whose frame is the ground truth's");
+  command->add_flag("--gt-sources", arguments->gt_sources,
+                    "render the novel views from the scene's ground-truth cameras and depth "
+                    "instead of the workspace's: measures the warp apart from the depth estimate");
   command->callback([arguments] {
     const SceneFolder scene{arguments->scene};
     const std::filesystem::path estimate_dir = arguments->workspace / "sparse";
@@ -172,6 +220,12 @@ void RegisterEvaluateCommand(CLI::App& app) {
       json["mesh"] = EvaluateMesh(mesh_obj, estimate, arguments->workspace, truth, scene,
                                   arguments->no_align ? Similarity3d{}
                                                       : evaluation.alignment.target_from_source);
+    }
+    if (std::filesystem::is_directory(scene.Novel().sparse) &&
+        (arguments->gt_sources || HasDepthMaps(depth_dir))) {
+      json["novel"] = EvaluateNovel(
+          scene, arguments->workspace, arguments->gt_sources,
+          arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source);
     }
     const nlohmann::json timings = ReconstructTimings(arguments->workspace);
     if (!timings.is_null()) json["timings_s"] = timings;

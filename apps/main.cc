@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   RegisterSynthCommand(app);
   RegisterReconstructCommand(app);
-  RegisterPendingCommand(app, "render", "Novel views of a workspace or scene folder");
+  RegisterRenderCommand(app);
   RegisterEvaluateCommand(app);
   RegisterPendingCommand(app, "view", "Shadowed, textured OpenGL viewer and screenshots");
   RegisterPendingCommand(app, "bench", "Error against run time over a grid of settings");

@@ -1,0 +1,45 @@
+#pragma once
+// Blending of several sources' warped samples into one target image.
+#include <cstdint>
+#include <vector>
+
+#include "core/depth_map.h"
+#include "core/image.h"
+#include "reproject/forward_warp.h"
+
+namespace parallax {
+
+struct BlendOptions {
+  // Samples within this relative depth of the front-most one at a pixel are one surface and
+  // are blended; farther ones are occluded. In (0, 1).
+  double depth_tolerance = 0.01;
+  // Added to the ray angle in the weight 1 / ((angle + epsilon) * max(1, stretch)), so a
+  // source that sees the point exactly along the target ray gets a large, finite weight
+  // (radians, > 0).
+  double angle_epsilon_rad = 0.01;
+
+  void Check() const;  // Throws std::invalid_argument naming the field and value.
+};
+
+// What landed on a target pixel.
+enum class SampleKind : uint8_t { kNone, kSurface, kBackground };
+
+struct BlendResult {
+  Image color;                   // Linear RGB, target size; 0 where nothing landed.
+  DepthMap depth;                // Surface z-depth; 0 for background and where nothing landed.
+  std::vector<SampleKind> kind;  // Row-major, one per pixel.
+
+  SampleKind Kind(int x, int y) const {
+    return kind[static_cast<size_t>(y) * static_cast<size_t>(color.Width()) +
+                static_cast<size_t>(x)];
+  }
+};
+
+// Per pixel: the front-most surface depth over all buffers; the surface samples within
+// depth_tolerance of it are averaged in linear light with Unstructured-Lumigraph-style
+// weights (smaller angle between source and target rays, less stretch -> larger weight).
+// Background samples are blended only where no surface sample landed. Parallel over rows.
+// Throws std::invalid_argument for no buffers or buffers of different sizes.
+BlendResult Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options);
+
+}  // namespace parallax

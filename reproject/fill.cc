@@ -1,0 +1,189 @@
+#include "reproject/fill.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/photo.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace parallax {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr int kMaxDirections = 16;
+
+bool ShouldFill(PixelClass c, const FillOptions& options) {
+  return IsHole(c) || (options.fill_out_of_view && c == PixelClass::kOutOfView);
+}
+
+struct Candidate {
+  float depth;  // +inf for background.
+  float distance_px;
+  const float* rgb;
+};
+
+class DepthAwareFiller {
+ public:
+  DepthAwareFiller(const FillOptions& options, BlendResult* blend)
+      : blend_(*blend), width_(blend->color.Width()), height_(blend->color.Height()),
+        count_(options.directions), tolerance_(static_cast<float>(options.background_tolerance)) {
+    for (int k = 0; k < count_; ++k) {
+      const double angle = 2 * kPi * k / count_;
+      dir_[static_cast<size_t>(k)] = {static_cast<float>(std::cos(angle)),
+                                      static_cast<float>(std::sin(angle))};
+    }
+  }
+
+  // Reads only pixels with samples and writes only the pixel itself (which has none), so rows
+  // can be filled in parallel in place.
+  bool FillPixel(int x, int y) {
+    std::array<Candidate, kMaxDirections> candidates;
+    int found = 0;
+    float farthest = 0;
+    for (int k = 0; k < count_; ++k) {
+      if (!March(x, y, dir_[static_cast<size_t>(k)], &candidates[static_cast<size_t>(found)])) continue;
+      farthest = std::max(farthest, candidates[static_cast<size_t>(found)].depth);
+      ++found;
+    }
+    if (found == 0) return false;
+    const bool background = std::isinf(farthest);
+    const float limit = background ? farthest : farthest * (1.0f - tolerance_);
+    float rgb[3] = {0, 0, 0}, depth = 0, weight = 0;
+    for (int k = 0; k < found; ++k) {
+      const Candidate& c = candidates[static_cast<size_t>(k)];
+      if (!(c.depth >= limit)) continue;
+      const float w = 1.0f / c.distance_px;
+      for (int ch = 0; ch < 3; ++ch) rgb[ch] += w * c.rgb[ch];
+      if (!background) depth += w * c.depth;
+      weight += w;
+    }
+    const size_t i = Index(x, y);
+    for (int ch = 0; ch < 3; ++ch) blend_.color.Pixels()[3 * i + static_cast<size_t>(ch)] = rgb[ch] / weight;
+    blend_.depth.Values()[i] = background ? 0.0f : depth / weight;
+    return true;
+  }
+
+ private:
+  size_t Index(int x, int y) const {
+    return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
+  }
+
+  bool March(int x, int y, const std::array<float, 2>& dir, Candidate* out) const {
+    const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
+    const float width = static_cast<float>(width_), height = static_cast<float>(height_);
+    for (int step = 1;; ++step) {
+      const float s = static_cast<float>(step);
+      const float qx = px + s * dir[0], qy = py + s * dir[1];
+      if (!(qx >= 0 && qy >= 0 && qx < width && qy < height)) return false;
+      // Non-negative here, so truncation is floor (std::floor is a library call).
+      const size_t j = Index(static_cast<int>(qx), static_cast<int>(qy));
+      const SampleKind kind = blend_.kind[j];
+      if (kind == SampleKind::kNone) continue;
+      out->depth = kind == SampleKind::kBackground ? std::numeric_limits<float>::infinity()
+                                                   : blend_.depth.Values()[j];
+      out->distance_px = s;
+      out->rgb = blend_.color.Pixels().data() + 3 * j;
+      return true;
+    }
+  }
+
+  BlendResult& blend_;
+  int width_;
+  int height_;
+  int count_;
+  float tolerance_;
+  std::array<std::array<float, 2>, kMaxDirections> dir_{};
+};
+
+int FillDepthAware(const ClassMap& classes, const FillOptions& options, BlendResult* blend) {
+  DepthAwareFiller filler(options, blend);
+  std::vector<int> filled_per_row(static_cast<size_t>(classes.height), 0);
+  tbb::parallel_for(0, classes.height, [&](int y) {
+    for (int x = 0; x < classes.width; ++x) {
+      if (ShouldFill(classes.At(x, y), options) && filler.FillPixel(x, y)) {
+        ++filled_per_row[static_cast<size_t>(y)];
+      }
+    }
+  });
+  int filled = 0;
+  for (int n : filled_per_row) filled += n;
+  return filled;
+}
+
+uint8_t ToSrgb8(float linear) {
+  const float encoded = LinearToSrgb(std::clamp(linear, 0.0f, 1.0f));
+  return static_cast<uint8_t>(std::lround(encoded * 255.0f));
+}
+
+int FillInpaint(const ClassMap& classes, const FillOptions& options, BlendResult* blend) {
+  const int width = classes.width, height = classes.height;
+  cv::Mat src(height, width, CV_8UC3), mask(height, width, CV_8UC1);
+  int to_fill = 0;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const bool fill = ShouldFill(classes.At(x, y), options);
+      to_fill += fill ? 1 : 0;
+      mask.at<uint8_t>(y, x) = fill ? 255 : 0;
+      cv::Vec3b& pixel = src.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) pixel[c] = ToSrgb8(blend->color.At(x, y, c));
+    }
+  }
+  // Telea needs at least one known pixel to propagate from.
+  if (to_fill == 0 || to_fill == width * height) return 0;
+  cv::Mat dst;
+  cv::inpaint(src, mask, dst, options.inpaint_radius_px, cv::INPAINT_TELEA);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (mask.at<uint8_t>(y, x) == 0) continue;
+      const cv::Vec3b& pixel = dst.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) blend->color.At(x, y, c) = SrgbToLinear(pixel[c] / 255.0f);
+    }
+  }
+  return to_fill;
+}
+
+}  // namespace
+
+void FillOptions::Check() const {
+  if (directions != 8 && directions != 16) {
+    throw std::invalid_argument("FillOptions.directions = " + std::to_string(directions) +
+                                ": expected 8 or 16");
+  }
+  if (!(background_tolerance > 0 && background_tolerance < 1)) {
+    throw std::invalid_argument("FillOptions.background_tolerance = " +
+                                std::to_string(background_tolerance) + ": expected (0, 1)");
+  }
+  if (!(inpaint_radius_px > 0 && std::isfinite(inpaint_radius_px))) {
+    throw std::invalid_argument("FillOptions.inpaint_radius_px = " +
+                                std::to_string(inpaint_radius_px) + ": expected > 0");
+  }
+}
+
+FillSummary FillHoles(const ClassMap& classes, const FillOptions& options, BlendResult* blend) {
+  options.Check();
+  if (classes.width != blend->color.Width() || classes.height != blend->color.Height()) {
+    throw std::invalid_argument("FillHoles: class map " + std::to_string(classes.width) + "x" +
+                                std::to_string(classes.height) + " does not match the image " +
+                                std::to_string(blend->color.Width()) + "x" +
+                                std::to_string(blend->color.Height()));
+  }
+  FillSummary summary;
+  if (options.method == FillMethod::kDepthAware) summary.filled_px = FillDepthAware(classes, options, blend);
+  if (options.method == FillMethod::kInpaint) summary.filled_px = FillInpaint(classes, options, blend);
+  size_t empty = 0;
+  for (PixelClass c : classes.classes) {
+    if (c != PixelClass::kCovered && c != PixelClass::kBackground) ++empty;
+  }
+  const size_t total = classes.classes.size();
+  const size_t left = empty - std::min(empty, static_cast<size_t>(summary.filled_px));
+  summary.hole_ratio_filled = total == 0 ? 0.0 : static_cast<double>(left) / static_cast<double>(total);
+  return summary;
+}
+
+}  // namespace parallax

@@ -1,0 +1,46 @@
+#pragma once
+// Hole filling after blending.
+#include "reproject/blend.h"
+#include "reproject/holes.h"
+
+namespace parallax {
+
+enum class FillMethod {
+  kNone,        // Holes stay black.
+  kInpaint,     // OpenCV's Telea inpainting on the 8-bit sRGB image (baseline); depth not filled.
+  kDepthAware,  // From the background side: see FillHoles.
+};
+
+struct FillOptions {
+  FillMethod method = FillMethod::kDepthAware;
+  // Also fill out-of-view pixels (the frame border), so the image has no black.
+  bool fill_out_of_view = true;
+  // kDepthAware: directions scanned from each pixel to the nearest sampled one; 8 or 16.
+  int directions = 16;
+  // kDepthAware: candidates within this relative depth of the farthest one are the
+  // background side and are averaged; in (0, 1).
+  double background_tolerance = 0.1;
+  // kInpaint: Telea neighbourhood radius in pixels, > 0.
+  double inpaint_radius_px = 3;
+
+  void Check() const;  // Throws std::invalid_argument naming the field and value.
+};
+
+struct FillSummary {
+  int filled_px = 0;  // Pixels that received a colour.
+  // Share of all pixels still without colour after filling (holes nothing reached, and
+  // out-of-view pixels when they are not filled). 0 when everything got a colour.
+  double hole_ratio_filled = 0;
+};
+
+// Fills the pixels of `blend` where nothing landed (holes; out-of-view ones too with
+// fill_out_of_view). kDepthAware scans `directions` rays from the pixel to the nearest pixel
+// with a sample, keeps the candidates whose depth is the farthest (background at infinity
+// counts as farthest) within background_tolerance, and averages their colours weighted by
+// inverse distance; surface fills also get that averaged depth. A disocclusion is hidden
+// background, so its colour comes from the background side, not from the occluder. The
+// sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad options
+// or a class map of another size.
+FillSummary FillHoles(const ClassMap& classes, const FillOptions& options, BlendResult* blend);
+
+}  // namespace parallax

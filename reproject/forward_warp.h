@@ -1,0 +1,109 @@
+#pragma once
+// Forward warp of one source view into a target camera with a z-buffer (nearest wins).
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+
+#include "reproject/view.h"
+
+namespace parallax {
+
+enum class WarpMethod {
+  kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
+  kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct.
+};
+
+struct ForwardWarpOptions {
+  WarpMethod method = WarpMethod::kMesh;
+  // Mesh: neighbouring samples belong to one surface while that surface's normal is within
+  // this angle of the source ray (degrees, in (0, 90)). Steeper "surfaces" are depth
+  // discontinuities: their triangles are dropped (a hole, not a rubber sheet). In pixels this
+  // is a depth ratio of 1 + tan(max_slant) * sqrt(2) / focal_px across a triangle.
+  double max_slant_deg = 86;
+  // Splat: footprints are at most this many target pixels across (>= 1).
+  double max_splat_px = 3;
+  // Splat: footprints are enlarged by this factor (>= 1) so neighbouring ones overlap and no
+  // pixel centre falls between them.
+  double splat_overlap = 1.1;
+  // Points are dropped when their target z is below this share of their distance from the
+  // target centre (at or behind the camera plane, or projecting absurdly far out); in (0, 1).
+  double min_view_cos = 1e-6;
+  // Depth-0 source pixels connected to the border (MarkBackground) are warped as directions
+  // and land as background at infinity; when false every depth-0 pixel is unknown.
+  bool background_at_infinity = true;
+
+  void Check() const;  // Throws std::invalid_argument naming the field and value.
+};
+
+// What the blend weighs a sample by. Plain data, deliberately without initialisers: buffers
+// of them are allocated without being cleared (only written where a sample lands).
+struct WarpWeight {
+  int32_t source;       // Index of the source in the render's list.
+  float ray_angle_rad;  // Angle at the 3D point between the rays from the source and the
+                        // target centres, as the chord 2 sin(angle / 2) (within 1% below 28
+                        // degrees; 0 for background, whose rays are parallel).
+  float stretch;        // Target pixels per source pixel (area ratio): > 1 where the source
+                        // is magnified, i.e. sampled too sparsely for the target.
+};
+
+// One source warped into the target, target-sized, struct of arrays, index y * width + x.
+class WarpBuffer {
+ public:
+  // Depth value of a background-at-infinity sample. Internal to the warp and blend: it never
+  // reaches a DepthMap or a file.
+  static constexpr float kBackground = std::numeric_limits<float>::infinity();
+
+  // Sizes the buffer and marks every pixel empty; keeps the memory when it is large enough.
+  void Reset(int width, int height);
+
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  size_t Size() const { return static_cast<size_t>(width_) * static_cast<size_t>(height_); }
+  // Target z-depth of the sample, 0 where nothing landed, kBackground for background.
+  float Depth(size_t i) const { return depth_[i]; }
+  // Linear RGB of the sample; meaningful only where Depth(i) != 0.
+  const float* Color(size_t i) const { return &color_[3 * i]; }
+  // Meaningful only where Depth(i) != 0.
+  const WarpWeight& Weight(size_t i) const { return weight_[i]; }
+
+  float* MutableDepth() { return depth_.get(); }
+  float* MutableColor() { return color_.get(); }
+  WarpWeight* MutableWeight() { return weight_.get(); }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  size_t capacity_ = 0;
+  std::unique_ptr<float[]> depth_;
+  std::unique_ptr<float[]> color_;
+  std::unique_ptr<WarpWeight[]> weight_;
+};
+
+// Per-source-pixel memory a warp needs (projections, masks); keeping one between calls saves
+// allocating and page-faulting ~8 MB per 640x480 source. One per concurrent warp.
+class WarpScratch {
+ public:
+  WarpScratch();
+  ~WarpScratch();
+  WarpScratch(WarpScratch&&) noexcept;
+  WarpScratch& operator=(WarpScratch&&) noexcept;
+
+  struct Data;  // Defined in forward_warp.cc.
+  Data& Get() { return *data_; }
+
+ private:
+  std::unique_ptr<Data> data_;
+};
+
+// Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
+// behind the target camera are dropped; source pixels with depth 0 are background (see
+// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). Per-pixel work
+// is parallel (TBB) and allocation-free. Throws std::invalid_argument for a non-pinhole
+// camera, mismatched sizes (CheckSourceView) or bad options.
+// `scratch` may be null (then the warp allocates its own).
+void ForwardWarp(const SourceView& source, int source_index, const PosedCamera& target,
+                 const ForwardWarpOptions& options, WarpBuffer* buffer,
+                 WarpScratch* scratch = nullptr);
+
+}  // namespace parallax

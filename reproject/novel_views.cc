@@ -1,0 +1,227 @@
+#include "reproject/novel_views.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <sstream>
+
+#include <Eigen/Dense>
+
+#include "core/depth_map.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
+#include "reproject/scene_views.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+// The point nearest to every source's optical axis in the least-squares sense: what the
+// photos look at. Falls back to the mean camera centre when the axes are (nearly) parallel.
+Eigen::Vector3d LookedAtPoint(const std::vector<PosedCamera>& sources) {
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero(), mean_centre = Eigen::Vector3d::Zero();
+  for (const PosedCamera& source : sources) {
+    const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
+    const Eigen::Vector3d axis =
+        source.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+    const Eigen::Matrix3d off_axis = Eigen::Matrix3d::Identity() - axis * axis.transpose();
+    normal += off_axis;
+    rhs += off_axis * centre;
+    mean_centre += centre;
+  }
+  mean_centre /= static_cast<double>(sources.size());
+  // The normal matrix is symmetric positive semi-definite; eigenvalues come sorted upwards.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
+  if (eigen.eigenvalues()(0) < 1e-6 * eigen.eigenvalues()(2)) return mean_centre;
+  return normal.ldlt().solve(rhs);
+}
+
+// World direction of the sources' mean image "up" (camera -y).
+Eigen::Vector3d MeanUp(const std::vector<PosedCamera>& sources) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const PosedCamera& source : sources) {
+    up += source.cam_from_world.rotation.conjugate() * -Eigen::Vector3d::UnitY();
+  }
+  return up.normalized();
+}
+
+std::string FrameName(const std::string& prefix, int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "%s_%04d", prefix.c_str(), index);
+  return name;
+}
+
+int ParseCount(const std::string& text, const std::string& spec) {
+  try {
+    size_t used = 0;
+    const int count = std::stoi(text, &used);
+    if (used == text.size() && count >= 1 && count <= 100000) return count;
+  } catch (const std::exception&) {
+  }
+  throw BadInputError("--path " + spec + ": '" + text + "' is not a frame count in 1..100000");
+}
+
+std::vector<NamedCamera> Orbit(int frames, const std::vector<PosedCamera>& sources) {
+  const Eigen::Vector3d centre = LookedAtPoint(sources);
+  const Eigen::Vector3d up = MeanUp(sources);
+  double radius = 0, height = 0;
+  for (const PosedCamera& source : sources) {
+    const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - centre;
+    height += offset.dot(up);
+    radius += (offset - offset.dot(up) * up).norm();
+  }
+  height /= static_cast<double>(sources.size());
+  radius /= static_cast<double>(sources.size());
+  const Eigen::Vector3d first = CameraCenter(sources.front().cam_from_world) - centre;
+  Eigen::Vector3d u = first - first.dot(up) * up;
+  if (u.norm() < 1e-9 * (1 + first.norm())) u = up.unitOrthogonal();
+  u.normalize();
+  const Eigen::Vector3d v = up.cross(u);
+  std::vector<NamedCamera> cameras;
+  for (int i = 0; i < frames; ++i) {
+    const double angle = 2 * std::numbers::pi * i / frames;
+    const Eigen::Vector3d eye =
+        centre + height * up + radius * (std::cos(angle) * u + std::sin(angle) * v);
+    cameras.push_back({FrameName("orbit", i),
+                       {sources.front().camera, LookAt(eye, centre, up)}});
+  }
+  return cameras;
+}
+
+}  // namespace
+
+ViewSetPaths SourcePathsFor(const fs::path& root) {
+  if (fs::is_directory(root / "sparse") && fs::is_directory(root / "depth")) {
+    ViewSetPaths paths;
+    paths.images = root / "images";
+    paths.sparse = root / "sparse";
+    paths.depth = root / "depth";
+    return paths;
+  }
+  const SceneFolder scene{root};
+  if (fs::is_directory(scene.Training().sparse) && fs::is_directory(scene.Training().depth)) {
+    return scene.Training();
+  }
+  throw BadInputError(root.string() + " is neither a workspace with depth maps (sparse/, "
+                      "depth/: run parallax reconstruct) nor a scene folder (gt/sparse, gt/depth)");
+}
+
+std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
+  const SparseModel model = ReadSparseModel(model_dir);
+  std::vector<NamedCamera> cameras;
+  for (const SparseImage& image : model.Images()) {
+    cameras.push_back({fs::path(image.name).stem().string(),
+                       {model.CameraById(image.camera_id), image.cam_from_world}});
+  }
+  if (cameras.empty()) throw BadInputError(model_dir.string() + ": the model has no images");
+  return cameras;
+}
+
+std::vector<NamedCamera> CamerasAlongPath(const std::string& spec,
+                                          const std::vector<PosedCamera>& sources,
+                                          const std::vector<std::string>& source_names) {
+  if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
+  const size_t colon = spec.find(':');
+  const std::string kind = spec.substr(0, colon);
+  const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
+  if (kind == "orbit" && colon != std::string::npos) return Orbit(ParseCount(rest, spec), sources);
+  if (kind == "between" && colon != std::string::npos) {
+    std::vector<std::string> parts;
+    std::istringstream words(rest);
+    for (std::string part; std::getline(words, part, ',');) parts.push_back(part);
+    if (parts.size() != 3) {
+      throw BadInputError("--path " + spec + ": expected between:IMAGE_A,IMAGE_B,N");
+    }
+    auto find = [&](const std::string& name) -> const PosedCamera& {
+      for (size_t i = 0; i < source_names.size(); ++i) {
+        if (source_names[i] == name || fs::path(source_names[i]).stem() == name) return sources[i];
+      }
+      throw BadInputError("--path " + spec + ": no source image named '" + name + "'");
+    };
+    const PosedCamera& a = find(parts[0]);
+    const PosedCamera& b = find(parts[1]);
+    const int frames = ParseCount(parts[2], spec);
+    std::vector<NamedCamera> cameras;
+    for (int i = 0; i < frames; ++i) {
+      const double t = frames == 1 ? 0.5 : static_cast<double>(i) / (frames - 1);
+      cameras.push_back({FrameName("between", i),
+                         {a.camera, InterpolatePose(a.cam_from_world, b.cam_from_world, t)}});
+    }
+    return cameras;
+  }
+  throw BadInputError("--path " + spec + ": expected orbit:N or between:IMAGE_A,IMAGE_B,N");
+}
+
+SourceLibrary::SourceLibrary(ViewSetPaths paths) : paths_(std::move(paths)) {
+  cameras_ = ReadPosedCameras(paths_, &names_);
+  loaded_.resize(cameras_.size());
+}
+
+const SourceView& SourceLibrary::Load(int index) {
+  std::unique_ptr<SourceView>& slot = loaded_.at(static_cast<size_t>(index));
+  if (!slot) {
+    auto view = std::make_unique<SourceView>();
+    const std::string& name = names_[static_cast<size_t>(index)];
+    view->name = name;
+    view->camera = cameras_[static_cast<size_t>(index)].camera;
+    view->cam_from_world = cameras_[static_cast<size_t>(index)].cam_from_world;
+    const Image photo = ReadImage(paths_.images / name);
+    view->color = SrgbToLinear(photo);
+    if (view->color.Channels() != 3) {
+      throw BadInputError((paths_.images / name).string() + ": expected an RGB image");
+    }
+    view->depth = ReadDepthExr(paths_.DepthFor(name));
+    if (view->depth.Width() != view->color.Width() || view->depth.Height() != view->color.Height()) {
+      throw BadInputError(paths_.DepthFor(name).string() + ": depth map and photo differ in size");
+    }
+    CheckSourceView(*view);
+    slot = std::move(view);
+  }
+  return *slot;
+}
+
+int SourceLibrary::LoadedCount() const {
+  int count = 0;
+  for (const auto& view : loaded_) count += view != nullptr;
+  return count;
+}
+
+NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
+                          const SourceSelectionOptions& selection, const RenderOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const auto select_start = Clock::now();
+  const std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
+  const auto select_end = Clock::now();
+  if (chosen.empty()) {
+    throw BadInputError("render " + target.name + ": no source view sees what this camera sees");
+  }
+  NovelView view;
+  std::vector<const SourceView*> sources;
+  for (int index : chosen) {
+    sources.push_back(&library.Load(index));
+    view.sources.push_back(library.Names()[static_cast<size_t>(index)]);
+  }
+  const auto render_start = Clock::now();
+  view.result = Render(sources, target.camera, options);
+  // Selection and rendering; reading files is left out (the first targets pay for all).
+  view.ms = std::chrono::duration<double, std::milli>(Clock::now() - render_start +
+                                                      (select_end - select_start))
+                .count();
+  return view;
+}
+
+void WriteNovelView(const fs::path& dir, const std::string& name, const RenderResult& result) {
+  fs::create_directories(dir);
+  WriteImage(dir / (name + ".png"), LinearToSrgb(result.color), PixelFormat::kUint8);
+  Image holes(result.classes.width, result.classes.height, 1);
+  for (size_t i = 0; i < result.classes.classes.size(); ++i) {
+    holes.Pixels()[i] = IsHole(result.classes.classes[i]) ? 1.0f : 0.0f;
+  }
+  WriteImage(dir / (name + ".holes.png"), holes, PixelFormat::kUint8);
+  WriteDepthExr(dir / (name + ".depth.exr"), result.depth);
+}
+
+}  // namespace parallax

@@ -1,0 +1,128 @@
+#include "reproject/source_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace parallax {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
+  return values[mid];
+}
+
+Eigen::Vector3d ViewDirection(const Rigid3d& cam_from_world) {
+  return cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
+}
+
+// Depth along the target axis where it passes closest to each source axis (skipping
+// near-parallel axes and points behind either camera); median of those.
+double EstimateSceneDepth(const std::vector<PosedCamera>& sources, const PosedCamera& target) {
+  const Eigen::Vector3d c0 = CameraCenter(target.cam_from_world);
+  const Eigen::Vector3d d0 = ViewDirection(target.cam_from_world);
+  std::vector<double> depths, distances;
+  for (const PosedCamera& source : sources) {
+    const Eigen::Vector3d c1 = CameraCenter(source.cam_from_world);
+    const Eigen::Vector3d d1 = ViewDirection(source.cam_from_world);
+    const double distance = (c1 - c0).norm();
+    if (distance > 0) distances.push_back(distance);
+    // Closest points of two lines: solve [d0 -d1] [s t]^T ~ c1 - c0.
+    const double b = d0.dot(d1);
+    const double denom = 1 - b * b;
+    if (denom < 1e-6) continue;
+    const Eigen::Vector3d w = c0 - c1;
+    const double s = (b * d1.dot(w) - d0.dot(w)) / denom;
+    const double t = (d1.dot(w) - b * d0.dot(w)) / denom;
+    if (s > 0 && t > 0 && std::isfinite(s)) depths.push_back(s);
+  }
+  if (!depths.empty()) return Median(depths);
+  return distances.empty() ? 1.0 : Median(distances);
+}
+
+SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, double scene_depth,
+                     const SourceSelectionOptions& options) {
+  const Pinhole t = Pinhole::From(target.camera);
+  const Pinhole s = Pinhole::From(source.camera);
+  const Rigid3d source_from_target = RelativePose(target.cam_from_world, source.cam_from_world);
+  const Eigen::Vector3d target_center_in_source = source_from_target.translation;
+  SourceScore score;
+  int samples = 0, seen = 0;
+  double angle_sum = 0;
+  for (double factor : {0.7, 1.0, 1.4}) {
+    for (int gy = 0; gy < options.grid_rows; ++gy) {
+      for (int gx = 0; gx < options.grid_cols; ++gx) {
+        ++samples;
+        const double u = (gx + 0.5) * t.width / options.grid_cols;
+        const double v = (gy + 0.5) * t.height / options.grid_rows;
+        const Eigen::Vector3d in_target((u - t.cx) / t.fx * scene_depth * factor,
+                                        (v - t.cy) / t.fy * scene_depth * factor,
+                                        scene_depth * factor);
+        const Eigen::Vector3d p = source_from_target * in_target;
+        if (!(p.z() > 1e-9 * p.norm())) continue;
+        const double su = s.fx * p.x() / p.z() + s.cx, sv = s.fy * p.y() / p.z() + s.cy;
+        if (!(su >= 0 && sv >= 0 && su <= s.width && sv <= s.height)) continue;
+        ++seen;
+        // Rays to the point from the source centre (origin here) and the target centre.
+        const Eigen::Vector3d from_target = p - target_center_in_source;
+        const double cos_angle = p.normalized().dot(from_target.normalized());
+        angle_sum += std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+      }
+    }
+  }
+  score.overlap = samples > 0 ? static_cast<double>(seen) / samples : 0;
+  score.mean_angle_deg = seen > 0 ? angle_sum / seen : 180;
+  score.score = score.overlap / (1 + score.mean_angle_deg / options.angle_scale_deg);
+  return score;
+}
+
+}  // namespace
+
+void SourceSelectionOptions::Check() const {
+  const auto fail = [](const std::string& field, double value, const std::string& expected) {
+    throw std::invalid_argument("SourceSelectionOptions." + field + " = " +
+                                std::to_string(value) + ": expected " + expected);
+  };
+  if (num_sources < 1) fail("num_sources", num_sources, ">= 1");
+  if (!(scene_depth >= 0 && std::isfinite(scene_depth))) fail("scene_depth", scene_depth, ">= 0");
+  if (grid_cols < 1) fail("grid_cols", grid_cols, ">= 1");
+  if (grid_rows < 1) fail("grid_rows", grid_rows, ">= 1");
+  if (!(min_overlap > 0 && min_overlap <= 1)) fail("min_overlap", min_overlap, "(0, 1]");
+  if (!(angle_scale_deg > 0 && std::isfinite(angle_scale_deg))) fail("angle_scale_deg", angle_scale_deg, "> 0");
+}
+
+std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
+                                      const PosedCamera& target,
+                                      const SourceSelectionOptions& options) {
+  options.Check();
+  const double scene_depth =
+      options.scene_depth > 0 ? options.scene_depth : EstimateSceneDepth(sources, target);
+  std::vector<SourceScore> scores;
+  for (size_t i = 0; i < sources.size(); ++i) {
+    SourceScore score = ScoreOne(sources[i], target, scene_depth, options);
+    score.index = static_cast<int>(i);
+    scores.push_back(score);
+  }
+  return scores;
+}
+
+std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
+                               const SourceSelectionOptions& options) {
+  std::vector<SourceScore> scores = ScoreSources(sources, target, options);
+  std::erase_if(scores, [&](const SourceScore& s) { return s.overlap < options.min_overlap; });
+  std::stable_sort(scores.begin(), scores.end(),
+                   [](const SourceScore& a, const SourceScore& b) { return a.score > b.score; });
+  std::vector<int> chosen;
+  for (const SourceScore& score : scores) {
+    if (static_cast<int>(chosen.size()) == options.num_sources) break;
+    chosen.push_back(score.index);
+  }
+  return chosen;
+}
+
+}  // namespace parallax

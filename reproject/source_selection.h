@@ -1,0 +1,48 @@
+#pragma once
+// Choice of the source views to render a target from, before any image is loaded.
+#include <vector>
+
+#include "reproject/view.h"
+
+namespace parallax {
+
+struct SourceSelectionOptions {
+  // How many sources to return at most (>= 1).
+  int num_sources = 4;
+  // Typical distance of the scene along the target's optical axis, in scene units; 0 estimates
+  // it as the median depth at which the target's axis passes closest to the sources' axes
+  // (cameras look at the scene), else the median distance to the source centres.
+  double scene_depth = 0;
+  // Target rays sampled on a grid_cols x grid_rows grid, at 0.7, 1 and 1.4 x scene_depth.
+  int grid_cols = 16;
+  int grid_rows = 12;
+  // Sources seeing less than this share of the samples cannot contribute: never returned.
+  double min_overlap = 0.05;
+  // The score overlap / (1 + mean_angle / angle_scale_deg) halves at this mean angle between
+  // source and target rays at the samples (degrees, > 0).
+  double angle_scale_deg = 10;
+
+  void Check() const;  // Throws std::invalid_argument naming the field and value.
+};
+
+struct SourceScore {
+  int index = -1;       // Into the list given to ScoreSources.
+  double overlap = 0;   // Share of the target samples the source sees, [0, 1].
+  double mean_angle_deg = 0;  // Mean angle between source and target rays at those samples.
+  double score = 0;
+};
+
+// Scores of every source, in input order.
+std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
+                                      const PosedCamera& target,
+                                      const SourceSelectionOptions& options);
+
+// Indices of up to num_sources sources with the best scores, best first: large overlap with
+// the target's view of the scene, small angles between their rays and the target's. Sources
+// with overlap below min_overlap (behind the target's scene, looking elsewhere) are never
+// returned, so fewer may come back. Throws std::invalid_argument for a non-pinhole camera or
+// bad options.
+std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
+                               const SourceSelectionOptions& options);
+
+}  // namespace parallax

@@ -1,0 +1,198 @@
+#include "reproject/forward_warp.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "reproject/background.h"
+#include "reproject/render.h"
+#include "tests/reproject/analytic_scene.h"
+
+namespace parallax {
+namespace {
+using test::CameraAt;
+using test::Scene;
+
+Camera TestCamera(int width = 160, int height = 120, double focal = 150) {
+  return MakePinholeCamera(1, static_cast<uint64_t>(width), static_cast<uint64_t>(height), focal,
+                           focal, width / 2.0, height / 2.0);
+}
+
+// A red box 4..5 in front of a blue wall at 8.
+Scene BoxScene() {
+  Scene scene;
+  scene.planes.push_back(test::WallAt(8, test::WavyTexture({0.1f, 0.2f, 0.7f}, 0.8)));
+  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
+  return scene;
+}
+
+TEST(ForwardWarp, IdentityPoseReproducesSourceForBothMethods) {
+  const PosedCamera camera = CameraAt(TestCamera(), {0, 0, 0});
+  const SourceView source = test::RenderView(BoxScene(), camera);
+  for (WarpMethod method : {WarpMethod::kMesh, WarpMethod::kSplat}) {
+    ForwardWarpOptions options;
+    options.method = method;
+    WarpBuffer buffer;
+    ForwardWarp(source, 0, camera, options, &buffer);
+    double max_color_error = 0, max_depth_error = 0;
+    for (int y = 0; y < 120; ++y) {
+      for (int x = 0; x < 160; ++x) {
+        const size_t i = static_cast<size_t>(y * 160 + x);
+        ASSERT_GT(buffer.Depth(i), 0) << x << "," << y;
+        max_depth_error = std::max(max_depth_error,
+                                   std::abs(static_cast<double>(buffer.Depth(i) - source.depth.At(x, y))) /
+                                       static_cast<double>(source.depth.At(x, y)));
+        for (int c = 0; c < 3; ++c) {
+          max_color_error = std::max(max_color_error, static_cast<double>(std::abs(buffer.Color(i)[c] - source.color.At(x, y, c))));
+        }
+      }
+    }
+    EXPECT_LT(max_depth_error, 1e-5);
+    EXPECT_LT(max_color_error, 1e-4);
+  }
+}
+
+TEST(ForwardWarp, MeshDropsTrianglesAcrossDepthDiscontinuities) {
+  const Camera camera = TestCamera();
+  const Scene scene = BoxScene();
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  const PosedCamera target = CameraAt(camera, {0.4, 0.1, 0});
+  ForwardWarpOptions options;
+  options.method = WarpMethod::kMesh;
+  WarpBuffer buffer;
+  ForwardWarp(source, 0, target, options, &buffer);
+  int intermediate = 0, surface = 0;
+  for (size_t i = 0; i < buffer.Size(); ++i) {
+    const float z = buffer.Depth(i);
+    if (z == 0) continue;
+    ++surface;
+    // The box front is at z 4 and the wall at 8: a rubber sheet between them would land here.
+    if (z > 4.04f && z < 7.92f) ++intermediate;
+  }
+  EXPECT_GT(surface, 160 * 120 / 2);
+  EXPECT_EQ(intermediate, 0);
+}
+
+TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
+  const Camera camera = TestCamera();
+  const SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
+  // Between box and wall, looking back at the box: the wall is behind the camera.
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  const PosedCamera target = CameraAt(camera, {0, 0, 6}, turn);
+  for (WarpMethod method : {WarpMethod::kMesh, WarpMethod::kSplat}) {
+    ForwardWarpOptions options;
+    options.method = method;
+    WarpBuffer buffer;
+    ForwardWarp(source, 0, target, options, &buffer);
+    for (size_t i = 0; i < buffer.Size(); ++i) {
+      const float z = buffer.Depth(i);
+      ASSERT_TRUE(z == 0 || (z > 0 && std::isfinite(z))) << z;
+      // Only the box (its front face seen from behind, 1..2 away) can be in front.
+      if (z > 0) {
+        EXPECT_LT(z, 2.01f);
+        EXPECT_TRUE(std::isfinite(buffer.Color(i)[0]));
+      }
+    }
+  }
+}
+
+TEST(MarkBackground, OnlyDepthZeroConnectedToTheBorderIsBackground) {
+  DepthMap depth(8, 6);
+  for (int y = 1; y < 5; ++y) {
+    for (int x = 1; x < 7; ++x) depth.At(x, y) = 3;
+  }
+  depth.At(3, 2) = 0;  // Enclosed: unknown.
+  depth.At(1, 3) = 0;  // Touches the border ring through (0, 3).
+  const std::vector<uint8_t> background = MarkBackground(depth);
+  EXPECT_EQ(background[0], 1);
+  EXPECT_EQ(background[2 * 8 + 3], 0);
+  EXPECT_EQ(background[3 * 8 + 1], 1);
+  EXPECT_EQ(background[2 * 8 + 2], 0);
+}
+
+// Sky colour encodes the world direction, so a warped sky pixel tells where it came from.
+Eigen::Vector3f SkyColor(const Eigen::Vector3d& dir) {
+  return Eigen::Vector3f(static_cast<float>(0.5 + 0.4 * dir.x() / dir.z()),
+                         static_cast<float>(0.5 + 0.4 * dir.y() / dir.z()), 0.3f);
+}
+
+TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
+  const Camera camera = TestCamera(160, 120, 150);
+  Scene scene;
+  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
+  scene.sky = SkyColor;
+  const PosedCamera source_camera = CameraAt(camera, {0, 0, 0});
+  const SourceView source = test::RenderView(scene, source_camera);
+  const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.08, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
+  const PosedCamera target = CameraAt(camera, {0, 0, 0}, rotation);
+  RenderOptions options;
+  options.fill.method = FillMethod::kNone;
+  const RenderResult result = Render({&source}, target, options);
+
+  int checked = 0, wrong_class = 0;
+  double max_error_px = 0;
+  for (int y = 0; y < 120; ++y) {
+    for (int x = 0; x < 160; ++x) {
+      const Eigen::Vector3d dir = test::PixelRay(target, x, y);
+      // Where the source sees this direction; skip its border and the box's silhouette.
+      const double su = 150 * dir.x() / dir.z() + 80, sv = 150 * dir.y() / dir.z() + 60;
+      if (su < 1.5 || sv < 1.5 || su > 158.5 || sv > 118.5) continue;
+      bool near_box = false;
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          near_box = near_box || scene.Intersect(Eigen::Vector3d::Zero(), test::PixelRay(target, x + dx, y + dy)).has_value();
+        }
+      }
+      if (near_box) continue;
+      ++checked;
+      if (result.classes.At(x, y) != PixelClass::kBackground) {
+        ++wrong_class;
+        continue;
+      }
+      // Decode the direction the colour came from and compare in source pixels.
+      const double red = result.color.At(x, y, 0), green = result.color.At(x, y, 1);
+      const double du = 150 * (red - 0.5) / 0.4 - 150 * dir.x() / dir.z();
+      const double dv = 150 * (green - 0.5) / 0.4 - 150 * dir.y() / dir.z();
+      max_error_px = std::max(max_error_px, std::hypot(du, dv));
+    }
+  }
+  EXPECT_GT(checked, 160 * 120 / 2);
+  EXPECT_EQ(wrong_class, 0);
+  EXPECT_LT(max_error_px, 0.02);
+  EXPECT_EQ(result.metrics.disocclusion_ratio, 0);
+  // Background never reaches the depth map.
+  for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z));
+}
+
+TEST(ForwardWarp, EnclosedDepthZeroIsAHoleNotBackground) {
+  const Camera camera = TestCamera();
+  SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
+  for (int y = 55; y < 65; ++y) {
+    for (int x = 75; x < 85; ++x) source.depth.At(x, y) = 0;  // Inside the box face.
+  }
+  RenderOptions options;
+  options.fill.method = FillMethod::kNone;
+  const RenderResult result = Render({&source}, CameraAt(camera, {0, 0, 0}), options);
+  EXPECT_EQ(test::CountClass(result.classes, PixelClass::kBackground), 0);
+  for (int y = 56; y < 64; ++y) {
+    for (int x = 76; x < 84; ++x) EXPECT_TRUE(IsHole(result.classes.At(x, y))) << x << "," << y;
+  }
+}
+
+TEST(ForwardWarp, RejectsDistortedCamerasAndBadOptions) {
+  SourceView source = test::RenderView(BoxScene(), CameraAt(TestCamera(), {0, 0, 0}));
+  source.camera.model = CameraModel::kSimpleRadial;
+  source.camera.params = {150, 80, 60, 0.1};
+  WarpBuffer buffer;
+  EXPECT_THROW(ForwardWarp(source, 0, CameraAt(TestCamera(), {0, 0, 0}), {}, &buffer),
+               std::invalid_argument);
+  ForwardWarpOptions options;
+  options.max_slant_deg = 90;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  source.camera = TestCamera(100, 120);
+  EXPECT_THROW(CheckSourceView(source), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace parallax

@@ -1,0 +1,231 @@
+#include "reproject/render.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tests/reproject/analytic_scene.h"
+
+namespace parallax {
+namespace {
+using test::CameraAt;
+using test::Scene;
+
+constexpr WarpMethod kMethods[] = {WarpMethod::kMesh, WarpMethod::kSplat};
+
+RenderOptions Options(WarpMethod method, FillMethod fill = FillMethod::kNone) {
+  RenderOptions options;
+  options.warp.method = method;
+  options.fill.method = fill;
+  return options;
+}
+
+const char* Name(WarpMethod method) { return method == WarpMethod::kMesh ? "mesh" : "splat"; }
+
+// 400x300, f 400: a red box (x, y in +-1 x +-0.75, z 4..5) in front of a blue wall at z 8.
+Camera BoxCamera() { return MakePinholeCamera(1, 400, 300, 400, 400, 200, 150); }
+Scene BoxScene() {
+  Scene scene;
+  scene.planes.push_back(test::WallAt(8, test::WavyTexture({0.1f, 0.2f, 0.7f}, 1.0)));
+  scene.boxes.push_back({{-1, -0.75, 4}, {1, 0.75, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.4)});
+  return scene;
+}
+
+// Target pixels on the wall, inside the source's image, whose wall point the box hides from
+// the source: the disocclusion by ray casting.
+long TrueDisocclusion(const Scene& scene, const PosedCamera& source, const PosedCamera& target) {
+  const Eigen::Vector3d source_center = CameraCenter(source.cam_from_world);
+  const Eigen::Vector3d target_center = CameraCenter(target.cam_from_world);
+  long count = 0;
+  for (int y = 0; y < static_cast<int>(target.camera.height); ++y) {
+    for (int x = 0; x < static_cast<int>(target.camera.width); ++x) {
+      const std::optional<test::Hit> hit = scene.Intersect(target_center, test::PixelRay(target, x, y));
+      if (!hit || hit->box) continue;
+      const std::optional<Eigen::Vector2d> pixel =
+          source.camera.Project(source.cam_from_world * hit->point);
+      if (!pixel || pixel->x() < 0 || pixel->y() < 0 || pixel->x() > source.camera.width ||
+          pixel->y() > source.camera.height) {
+        continue;
+      }
+      if (scene.Occluded(source_center, hit->point)) ++count;
+    }
+  }
+  return count;
+}
+
+TEST(Render, PlaneMovedSidewaysHasNoHolesAndAnOutOfViewStrip) {
+  const Camera camera = MakePinholeCamera(1, 320, 240, 300, 300, 160, 120);
+  Scene scene;
+  // 24 target pixels per texture period at depth 5.
+  scene.planes.push_back(test::WallAt(5, test::WavyTexture({0.45f, 0.4f, 0.35f}, 0.4)));
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  // 15.5 px of disparity: the right 15.5 px of the target are not in the source.
+  const double baseline = 15.5 * 5 / 300;
+  const PosedCamera target = CameraAt(camera, {baseline, 0, 0});
+  const SourceView truth = test::RenderView(scene, target);
+  for (WarpMethod method : kMethods) {
+    SCOPED_TRACE(Name(method));
+    const RenderResult result = Render({&source}, target, Options(method));
+    EXPECT_LT(result.metrics.hole_ratio, 0.001);
+    EXPECT_NEAR(result.metrics.out_of_view_ratio, 15.5 / 320, 0.05 * 15.5 / 320);
+    EXPECT_EQ(result.metrics.background_ratio, 0);
+    const double psnr = test::PsnrSrgb(result.color, truth.color, [&](int x, int y) {
+      return result.classes.At(x, y) == PixelClass::kCovered;
+    });
+    EXPECT_GE(psnr, 30);
+    for (int y = 0; y < 240; ++y) {
+      EXPECT_EQ(result.classes.At(319, y), PixelClass::kOutOfView);
+      EXPECT_EQ(result.classes.At(300, y), PixelClass::kCovered);
+    }
+  }
+}
+
+TEST(Render, BoxInFrontOfWallDisocclusionMatchesRayCasting) {
+  const Scene scene = BoxScene();
+  const PosedCamera source_camera = CameraAt(BoxCamera(), {0, 0, 0});
+  const SourceView source = test::RenderView(scene, source_camera);
+  // 40 px more disparity on the box than on the wall: a 40 px wide disocclusion.
+  const PosedCamera target = CameraAt(BoxCamera(), {0.8, 0, 0});
+  const long truth = TrueDisocclusion(scene, source_camera, target);
+  ASSERT_GT(truth, 5000);
+  for (WarpMethod method : kMethods) {
+    SCOPED_TRACE(Name(method));
+    const RenderResult result = Render({&source}, target, Options(method));
+    const long disocclusion = test::CountClass(result.classes, PixelClass::kDisocclusion);
+    const long holes = disocclusion + test::CountClass(result.classes, PixelClass::kCrack);
+    EXPECT_NEAR(static_cast<double>(disocclusion), static_cast<double>(truth), 0.04 * static_cast<double>(truth));
+    EXPECT_NEAR(static_cast<double>(holes), static_cast<double>(truth), 0.04 * static_cast<double>(truth));
+    EXPECT_EQ(result.metrics.hole_count, 1);
+    EXPECT_NEAR(result.metrics.largest_hole_px, holes, 0);
+  }
+}
+
+TEST(Render, PureRotationHasNoDisocclusion) {
+  const Scene scene = BoxScene();
+  const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
+  const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.1, Eigen::Vector3d(0.3, 1, 0).normalized()));
+  const PosedCamera target = CameraAt(BoxCamera(), {0, 0, 0}, rotation);
+  const SourceView truth = test::RenderView(scene, target);
+  for (WarpMethod method : kMethods) {
+    SCOPED_TRACE(Name(method));
+    const RenderResult result = Render({&source}, target, Options(method));
+    EXPECT_EQ(result.metrics.disocclusion_ratio, 0);
+    EXPECT_LT(result.metrics.crack_ratio, 0.001);
+    EXPECT_GT(result.metrics.out_of_view_ratio, 0.05);
+    const double psnr = test::PsnrSrgb(result.color, truth.color, [&](int x, int y) {
+      return result.classes.At(x, y) == PixelClass::kCovered;
+    });
+    EXPECT_GE(psnr, 30);
+  }
+}
+
+TEST(Render, TwoSourcesOnEitherSideShrinkTheHoles) {
+  const Scene scene = BoxScene();
+  const SourceView left = test::RenderView(scene, CameraAt(BoxCamera(), {-0.6, 0, 0}), "left");
+  const SourceView right = test::RenderView(scene, CameraAt(BoxCamera(), {0.6, 0, 0}), "right");
+  const PosedCamera target = CameraAt(BoxCamera(), {0, 0.05, 0});
+  const SourceView truth = test::RenderView(scene, target);
+  for (WarpMethod method : kMethods) {
+    SCOPED_TRACE(Name(method));
+    const RenderResult one = Render({&left}, target, Options(method));
+    const RenderResult both = Render({&left, &right}, target, Options(method));
+    EXPECT_GT(one.metrics.hole_ratio, 0.01);
+    EXPECT_LT(both.metrics.hole_ratio, 0.1 * one.metrics.hole_ratio);
+    EXPECT_LT(both.metrics.out_of_view_ratio, one.metrics.out_of_view_ratio);
+    const double psnr = test::PsnrSrgb(both.color, truth.color, [&](int x, int y) {
+      return both.classes.At(x, y) == PixelClass::kCovered;
+    });
+    EXPECT_GE(psnr, 30);
+  }
+}
+
+void ExpectFinite(const RenderResult& result) {
+  for (float v : result.color.Pixels()) ASSERT_TRUE(std::isfinite(v));
+  for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z) && z >= 0) << z;
+  const HoleMetrics& m = result.metrics;
+  for (double ratio : {m.covered_ratio, m.background_ratio, m.out_of_view_ratio, m.crack_ratio,
+                       m.disocclusion_ratio, m.hole_ratio, result.fill.hole_ratio_filled}) {
+    ASSERT_TRUE(ratio >= 0 && ratio <= 1) << ratio;
+  }
+  EXPECT_NEAR(m.covered_ratio + m.background_ratio + m.out_of_view_ratio + m.hole_ratio, 1, 1e-9);
+}
+
+void RenderAllWays(const std::vector<const SourceView*>& sources, const PosedCamera& target) {
+  for (WarpMethod method : kMethods) {
+    for (FillMethod fill : {FillMethod::kNone, FillMethod::kInpaint, FillMethod::kDepthAware}) {
+      SCOPED_TRACE(std::string(Name(method)) + " fill " + std::to_string(static_cast<int>(fill)));
+      ExpectFinite(Render(sources, target, Options(method, fill)));
+    }
+  }
+}
+
+TEST(Render, TargetInsideTheSceneStaysFinite) {
+  const Scene scene = BoxScene();
+  const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  RenderAllWays({&source}, CameraAt(BoxCamera(), {0, 0, 6}, turn));  // Between box and wall.
+  RenderAllWays({&source}, CameraAt(BoxCamera(), {0.2, 0.1, 4.5}));  // Inside the box.
+  RenderAllWays({&source}, CameraAt(BoxCamera(), {0, 0, 9}));        // Behind the wall.
+}
+
+TEST(Render, SourcePixelOnTheTargetCameraPlaneStaysFinite) {
+  // Odd size with the principal point on a pixel centre: column 10 looks along x = 0, row 7
+  // along y = 0, so their points on the plane z = 5 lie in the target's camera plane x = 0
+  // and one of them is the target centre itself.
+  const Camera camera = MakePinholeCamera(1, 21, 15, 20, 20, 10.5, 7.5);
+  Scene scene;
+  scene.planes.push_back(test::WallAt(5, test::WavyTexture({0.5f, 0.5f, 0.5f}, 0.5)));
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  ASSERT_EQ(source.depth.At(10, 7), 5.0f);
+  const PosedCamera target{camera, LookAt({0, 0, 5}, {1, 0, 5}, {0, 0, 1})};
+  RenderAllWays({&source}, target);
+  const PosedCamera grazing{camera, LookAt({0, 0, 5}, {1, 0, 5.001}, {0, 0, 1})};
+  RenderAllWays({&source}, grazing);
+}
+
+TEST(Render, ExtremeDepthsStayFinite) {
+  const Camera camera = MakePinholeCamera(1, 32, 24, 30, 30, 16, 12);
+  const PosedCamera origin = CameraAt(camera, {0, 0, 0});
+  for (float depth : {1e-6f, 1e6f}) {
+    SourceView source = test::RenderView(Scene{}, origin);
+    for (float& z : source.depth.Values()) z = depth;
+    RenderAllWays({&source}, CameraAt(camera, {0.1, 0, 0}));
+    RenderAllWays({&source}, CameraAt(camera, {0, 0, 1e-6}));
+  }
+  // A checkerboard of depths 1e-3 and 1e3: a discontinuity of 1e6 between every pair.
+  SourceView checker = test::RenderView(Scene{}, origin);
+  for (int y = 0; y < 24; ++y) {
+    for (int x = 0; x < 32; ++x) checker.depth.At(x, y) = (x + y) % 2 == 0 ? 1e-3f : 1e3f;
+  }
+  RenderAllWays({&checker}, CameraAt(camera, {0.01, 0, 0}));
+}
+
+TEST(Render, OnePixelImagesStayFinite) {
+  const Camera camera = MakePinholeCamera(1, 1, 1, 1, 1, 0.5, 0.5);
+  Scene scene;
+  scene.planes.push_back(test::WallAt(3, test::WavyTexture({0.5f, 0.5f, 0.5f}, 0.5)));
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  RenderAllWays({&source}, CameraAt(camera, {0, 0, 0}));
+  RenderAllWays({&source}, CameraAt(camera, {5, 0, 0}));
+  const RenderResult same = Render({&source}, CameraAt(camera, {0, 0, 0}), Options(WarpMethod::kMesh));
+  EXPECT_EQ(same.classes.At(0, 0), PixelClass::kCovered);
+}
+
+TEST(Render, RejectsBadInput) {
+  const Scene scene = BoxScene();
+  const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
+  const PosedCamera target = CameraAt(BoxCamera(), {0, 0, 0});
+  EXPECT_THROW(Render({}, target), std::invalid_argument);
+  EXPECT_THROW(Render({nullptr}, target), std::invalid_argument);
+  RenderOptions options;
+  options.holes.crack_opening_px = 2;
+  EXPECT_THROW(Render({&source}, target, options), std::invalid_argument);
+  PosedCamera distorted = target;
+  distorted.camera = Camera{1, CameraModel::kOpenCV, 400, 300, {400, 400, 200, 150, 0.1, 0, 0, 0}};
+  EXPECT_THROW(Render({&source}, distorted), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace parallax
