@@ -2,11 +2,14 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "apps/commands.h"
+#include "apps/terminal_progress.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "pipeline/mvs.h"
 #include "reproject/novel_views.h"
 
 namespace parallax {
@@ -22,6 +25,34 @@ std::string CsvRow(const std::string& name, const NovelView& view) {
                 m.disocclusion_ratio, m.out_of_view_ratio, m.background_ratio, m.hole_count,
                 m.largest_hole_px, view.ms);
   return row;
+}
+
+// A workspace made with `reconstruct --no-depth` (or missing some depth maps) gets depth for
+// the source views the targets use, and for no other view. Returns the names estimated.
+std::vector<std::string> EstimateMissingDepth(const std::filesystem::path& workspace,
+                                              const SourceLibrary& library,
+                                              const std::vector<NamedCamera>& targets,
+                                              const SourceSelectionOptions& selection) {
+  std::set<std::string> missing;
+  for (const NamedCamera& target : targets) {
+    for (int index : SelectSources(library.Cameras(), target.camera, selection)) {
+      const std::string& name = library.Names()[static_cast<size_t>(index)];
+      const auto stem = std::filesystem::path(name).stem().string();
+      if (!std::filesystem::exists(workspace / "depth" / (stem + ".exr"))) missing.insert(name);
+    }
+  }
+  if (missing.empty()) return {};
+  MvsOptions options = MvsOptionsFor(Quality::kBalanced);
+  options.only_views.assign(missing.begin(), missing.end());
+  MvsSummary summary;
+  {
+    TerminalProgress progress;
+    summary = RunMultiViewStereo(workspace, options, progress);
+  }
+  std::printf("depth: estimated %zu of %zu views (PatchMatch on %d, for the geometric check); "
+              "the other views are not needed by these cameras\n",
+              summary.views.size(), library.Cameras().size(), summary.estimated_views);
+  return options.only_views;
 }
 
 }  // namespace
@@ -75,6 +106,9 @@ void RegisterRenderCommand(CLI::App& app) {
         arguments->cameras.empty()
             ? CamerasAlongPath(arguments->path, library.Cameras(), library.Names())
             : CamerasFromModel(arguments->cameras);
+    if (!std::filesystem::is_directory(arguments->input / "gt")) {
+      EstimateMissingDepth(arguments->input, library, targets, arguments->selection);
+    }
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
         "out_of_view_ratio,background_ratio,holes,largest_hole_px,ms\n";

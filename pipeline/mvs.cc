@@ -1,7 +1,10 @@
 #include "pipeline/mvs.h"
 
+#include <algorithm>
 #include <chrono>
+#include <stdexcept>
 #include <map>
+#include <set>
 
 #include "core/depth_map.h"
 #include "core/error.h"
@@ -53,6 +56,7 @@ void MvsOptions::Check() const {
   views.Check();
   patch_match.Check();
   filter.Check();
+  if (filter_sources < 1) throw std::invalid_argument("MvsOptions: filter_sources must be >= 1");
 }
 
 MvsOptions MvsOptionsFor(Quality quality) {
@@ -89,19 +93,44 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
                               Progress& progress) {
   options.Check();
   const SparseModel model = ReadSparseModel(workspace / "sparse");
-  const std::vector<ViewPlan> plans = PlanViews(model, options.views);
+  const std::vector<ViewPlan> all_plans = PlanViews(model, options.views);
+  const std::set<std::string> wanted(options.only_views.begin(), options.only_views.end());
+  // `plans`: the views whose depth is written; `estimated`: those plus the sources the
+  // geometric filter needs.
+  std::vector<ViewPlan> plans;
+  std::set<uint32_t> estimated;
+  for (const ViewPlan& plan : all_plans) {
+    if (!wanted.empty() && !wanted.count(plan.name)) continue;
+    plans.push_back(plan);
+    estimated.insert(plan.image_id);
+    const size_t filter_sources = wanted.empty() ? plan.sources.size()
+                                                 : std::min(plan.sources.size(), static_cast<size_t>(options.filter_sources));
+    estimated.insert(plan.sources.begin(), plan.sources.begin() + static_cast<std::ptrdiff_t>(filter_sources));
+  }
+  std::vector<ViewPlan> estimate_plans;
+  for (const ViewPlan& plan : all_plans) {
+    if (estimated.count(plan.image_id)) estimate_plans.push_back(plan);
+  }
+  for (const std::string& name : wanted) {
+    if (!model.FindImageByName(name)) {
+      throw BadInputError(workspace.string() + ": no image named " + name + " in the sparse model");
+    }
+  }
   MvsSummary summary;
-  if (plans.size() < model.Images().size()) {
-    for (const SparseImage& image : model.Images()) {
-      const bool planned = std::any_of(plans.begin(), plans.end(),
-                                       [&](const ViewPlan& plan) { return plan.image_id == image.id; });
-      if (!planned) summary.skipped.push_back(image.name + ": too few sparse points or no source view");
+  summary.estimated_views = static_cast<int>(estimate_plans.size());
+  for (const SparseImage& image : model.Images()) {
+    const bool planned = std::any_of(all_plans.begin(), all_plans.end(),
+                                     [&](const ViewPlan& plan) { return plan.image_id == image.id; });
+    if (!planned) {
+      summary.skipped.push_back(image.name + ": too few sparse points or no source view");
+    } else if (!wanted.empty() && !wanted.count(image.name)) {
+      summary.skipped.push_back(image.name + ": not requested");
     }
   }
 
   // Every image that takes part, as reference or as source, loaded once.
   std::map<uint32_t, StereoView> views;
-  for (const ViewPlan& plan : plans) {
+  for (const ViewPlan& plan : estimate_plans) {
     for (uint32_t id : plan.sources) views[id];
     views[plan.image_id];
   }
@@ -114,9 +143,9 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
 
   auto start = std::chrono::steady_clock::now();
   std::map<uint32_t, DepthNormalMap> estimates;
-  for (size_t i = 0; i < plans.size(); ++i) {
-    progress.Update("depth", static_cast<int64_t>(i), static_cast<int64_t>(plans.size()));
-    const ViewPlan& plan = plans[i];
+  for (size_t i = 0; i < estimate_plans.size(); ++i) {
+    progress.Update("depth", static_cast<int64_t>(i), static_cast<int64_t>(estimate_plans.size()));
+    const ViewPlan& plan = estimate_plans[i];
     std::vector<const StereoView*> sources;
     for (uint32_t id : plan.sources) sources.push_back(&views.at(id));
     PatchMatchOptions patch_match = options.patch_match;
@@ -125,7 +154,8 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
     patch_match.seed = plan.image_id;
     estimates[plan.image_id] = PatchMatchStereo(views.at(plan.image_id), sources, patch_match);
   }
-  progress.Update("depth", static_cast<int64_t>(plans.size()), static_cast<int64_t>(plans.size()));
+  progress.Update("depth", static_cast<int64_t>(estimate_plans.size()),
+                  static_cast<int64_t>(estimate_plans.size()));
   summary.photometric_seconds = Seconds(start);
 
   start = std::chrono::steady_clock::now();

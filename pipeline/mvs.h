@@ -19,6 +19,11 @@ struct MvsOptions {
   ViewSelectionOptions views;
   PatchMatchOptions patch_match;  // Its depth range is set per view from the sparse points.
   GeometricFilterOptions filter;
+  // Only these views (image names) get depth maps; empty means every view. Their first
+  // `filter_sources` source views are estimated too (photometric only, not written), since
+  // the geometric filter checks each depth against its sources' estimates.
+  std::vector<std::string> only_views;
+  int filter_sources = 2;
   void Check() const;
 };
 
@@ -37,7 +42,8 @@ struct MvsViewReport {
 };
 
 struct MvsSummary {
-  std::vector<MvsViewReport> views;
+  std::vector<MvsViewReport> views;  // The views whose depth maps were written.
+  int estimated_views = 0;           // Views PatchMatch ran on (more than `views` with only_views).
   std::vector<std::string> skipped;  // Views without depth, and why.
   double photometric_seconds = 0;
   double geometric_seconds = 0;

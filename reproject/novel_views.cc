@@ -94,7 +94,7 @@ std::vector<NamedCamera> Orbit(int frames, const std::vector<PosedCamera>& sourc
 }  // namespace
 
 ViewSetPaths SourcePathsFor(const fs::path& root) {
-  if (fs::is_directory(root / "sparse") && fs::is_directory(root / "depth")) {
+  if (fs::is_directory(root / "sparse") && fs::is_directory(root / "images")) {
     ViewSetPaths paths;
     paths.images = root / "images";
     paths.sparse = root / "sparse";
@@ -105,8 +105,8 @@ ViewSetPaths SourcePathsFor(const fs::path& root) {
   if (fs::is_directory(scene.Training().sparse) && fs::is_directory(scene.Training().depth)) {
     return scene.Training();
   }
-  throw BadInputError(root.string() + " is neither a workspace with depth maps (sparse/, "
-                      "depth/: run parallax reconstruct) nor a scene folder (gt/sparse, gt/depth)");
+  throw BadInputError(root.string() + " is neither a workspace (sparse/, images/: run parallax "
+                      "reconstruct) nor a scene folder (gt/sparse, gt/depth)");
 }
 
 std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {

@@ -13,8 +13,9 @@
 
 namespace parallax {
 
-// The sources of a workspace (<ws>/sparse, images, depth) or of a scene folder (its training
-// set). Throws BadInputError naming the folder when it is neither.
+// The sources of a workspace (<ws>/sparse, images, depth; depth maps may still be missing)
+// or of a scene folder (its training set). Throws BadInputError naming the folder when it is
+// neither.
 ViewSetPaths SourcePathsFor(const std::filesystem::path& workspace_or_scene);
 
 struct NamedCamera {

@@ -1,0 +1,92 @@
+// `parallax render` through the real executable: outputs, the leave-out of depth estimation,
+// and its error paths.
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "core/atomic_file.h"
+#include "core/depth_map.h"
+#include "core/image.h"
+#include "tests/cli_runner.h"
+#include "tests/temp_dir.h"
+
+namespace parallax {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+
+std::vector<std::string> Lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream stream(text);
+  for (std::string line; std::getline(stream, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(RenderCli, SceneFolderNovelCamerasWriteImagesMasksDepthAndCsv) {
+  const TempDir dir;
+  const CliResult result = RunParallax("render " + Quote(kSmall.string()) + " --cameras " +
+                                       Quote((kSmall / "novel" / "sparse").string()) + " --out " +
+                                       Quote(dir.Path().string()) + " --sources 4");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const std::vector<std::string> csv = Lines(ReadFileBytes(dir.Path() / "render.csv"));
+  ASSERT_EQ(csv.size(), 5u);  // Header + 4 novel views.
+  EXPECT_EQ(csv[0].rfind("name,sources,hole_ratio,hole_ratio_filled,", 0), 0u) << csv[0];
+  for (const std::string name : {"novel_0000", "novel_0001", "novel_0002", "novel_0003"}) {
+    const Image colour = ReadImage(dir.Path() / (name + std::string(".png")));
+    EXPECT_EQ(colour.Width(), 320);
+    EXPECT_EQ(colour.Height(), 240);
+    const Image holes = ReadImage(dir.Path() / (name + std::string(".holes.png")));
+    EXPECT_EQ(holes.Channels(), 1);
+    const DepthMap depth = ReadDepthExr(dir.Path() / (name + std::string(".depth.exr")));
+    EXPECT_EQ(depth.Width(), 320);
+  }
+}
+
+TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
+  const TempDir dir;
+  const fs::path workspace = dir.Path() / "ws";
+  const CliResult sfm = RunParallax(
+      "reconstruct " + Quote((kSmall / "images").string()) + " " + Quote(workspace.string()) +
+      " --known-cameras " + Quote((kSmall / "gt" / "sparse").string()) + " --no-depth");
+  ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
+  ASSERT_FALSE(fs::exists(workspace / "depth"));
+  const CliResult render = RunParallax("render " + Quote(workspace.string()) +
+                                       " --path between:0003.png,0005.png,2 --sources 2 --out " +
+                                       Quote((dir.Path() / "out").string()));
+  ASSERT_EQ(render.exit_code, 0) << render.output;
+  EXPECT_NE(render.output.find("the other views are not needed"), std::string::npos)
+      << render.output;
+  size_t maps = 0;
+  for (const auto& entry : fs::directory_iterator(workspace / "depth")) {
+    maps += entry.path().string().ends_with(".confidence.exr") ? 0 : 1;
+  }
+  EXPECT_GE(maps, 2u);
+  EXPECT_LE(maps, 4u) << "only the sources of two frames between 0003 and 0005";
+  EXPECT_TRUE(fs::exists(dir.Path() / "out" / "between_0001.png"));
+}
+
+TEST(RenderCli, BadInputExitsTwoAndNamesTheProblem) {
+  const TempDir dir;
+  const CliResult empty = RunParallax("render " + Quote(dir.Path().string()) +
+                                      " --path orbit:3 --out " + Quote((dir.Path() / "o").string()));
+  EXPECT_EQ(empty.exit_code, 2) << empty.output;
+  EXPECT_NE(empty.output.find("neither a workspace"), std::string::npos) << empty.output;
+  const CliResult path = RunParallax("render " + Quote(kSmall.string()) +
+                                     " --path spiral:3 --out " + Quote((dir.Path() / "o").string()));
+  EXPECT_EQ(path.exit_code, 2) << path.output;
+  EXPECT_NE(path.output.find("expected orbit:N"), std::string::npos) << path.output;
+  const CliResult name = RunParallax("render " + Quote(kSmall.string()) +
+                                     " --path between:0000.png,nope.png,3 --out " +
+                                     Quote((dir.Path() / "o").string()));
+  EXPECT_EQ(name.exit_code, 2) << name.output;
+  EXPECT_NE(name.output.find("no source image named 'nope.png'"), std::string::npos) << name.output;
+  const CliResult no_cameras =
+      RunParallax("render " + Quote(kSmall.string()) + " --out " + Quote((dir.Path() / "o").string()));
+  EXPECT_EQ(no_cameras.exit_code, 1) << no_cameras.output;
+}
+
+}  // namespace
+}  // namespace parallax
