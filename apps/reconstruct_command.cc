@@ -99,6 +99,15 @@ void RegisterReconstructCommand(CLI::App& app) {
       ->check(CLI::ExistingDirectory);
   command->add_flag("--no-depth", arguments->no_depth,
                     "stop after structure from motion (no multi-view stereo)");
+  const std::map<std::string, StereoMethod> stereo_methods = {
+      {"patchmatch", StereoMethod::kPatchMatch}, {"sgbm", StereoMethod::kSgbm}};
+  command->add_option("--stereo", arguments->options.stereo,
+                      "depth method: patchmatch (default) or sgbm (OpenCV StereoSGBM on "
+                      "rectified pairs, the baseline)")
+      ->transform(CLI::CheckedTransformer(stereo_methods, CLI::ignore_case));
+  command->add_option("--mvs-sources", arguments->options.mvs_sources,
+                      "source views per depth map (default: as --quality says: 3, 5, 7)")
+      ->check(CLI::Range(1, 32));
   command->add_flag("--no-mesh", arguments->no_mesh,
                     "stop after depth maps and the fused cloud (no textured mesh)");
   command->add_flag("--strict", arguments->options.strict,

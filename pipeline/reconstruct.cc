@@ -16,6 +16,7 @@
 #include "pipeline/colmap_database.h"
 #include "pipeline/fusion.h"
 #include "pipeline/mesh.h"
+#include "pipeline/sgbm.h"
 #include "pipeline/mvs.h"
 #include "pipeline/stage_cache.h"
 
@@ -614,11 +615,17 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                                       .Add(undistort_key)
                                       .Add(kMvsVersion)
                                       .Add(static_cast<uint64_t>(options.quality))
+                                      .Add(static_cast<uint64_t>(options.stereo))
+                                      .Add(static_cast<uint64_t>(options.mvs_sources))
                                       .Hex();
     const fs::path views_file = workspace / "depth" / "views.json";
     stages.Run("depth", depth_key, views_file, [&] {
+      MvsOptions mvs_options = MvsOptionsFor(options.quality);
+      if (options.mvs_sources > 0) mvs_options.views.max_sources = options.mvs_sources;
       const MvsSummary mvs =
-          RunMultiViewStereo(workspace, MvsOptionsFor(options.quality), progress);
+          options.stereo == StereoMethod::kSgbm
+              ? RunSgbmStereo(workspace, mvs_options.views, {}, progress)
+              : RunMultiViewStereo(workspace, mvs_options, progress);
       WriteFileAtomically(views_file, MvsSummaryJson(mvs).dump(2) + "\n");
     });
     summary.depth_views = nlohmann::json::parse(ReadFileBytes(views_file));

@@ -25,6 +25,8 @@ enum class MatcherChoice {
   kSequential,  // Neighbours in name order, plus the ends of the sequence (loop closure).
 };
 
+enum class StereoMethod { kPatchMatch, kSgbm };
+
 struct ReconstructOptions {
   Quality quality = Quality::kBalanced;
   MatcherChoice matcher = MatcherChoice::kAuto;
@@ -56,6 +58,11 @@ struct ReconstructOptions {
   PlausibilityOptions plausibility;
   // Run multi-view stereo after SfM (pipeline/mvs.h), at `quality`.
   bool estimate_depth = true;
+  // Depth-stage method: parallax's PatchMatch, or OpenCV's StereoSGBM on rectified pairs (the
+  // baseline the bench compares with).
+  StereoMethod stereo = StereoMethod::kPatchMatch;
+  // Source views per depth map; 0 = as `quality` says.
+  int mvs_sources = 0;
   // After depth: Poisson mesh, trimmed and textured (pipeline/mesh.h).
   bool build_mesh = true;
   void Check() const;  // Throws std::invalid_argument naming the field.

@@ -9,6 +9,7 @@ namespace parallax {
 
 struct ProcessResult {
   int exit_code = 0;  // The program's exit status; 128 + N when killed by signal N.
+  long peak_memory_kb = 0;  // The child's peak resident set size (its own, not its children's).
 };
 
 // Runs argv[0] (a path or a name looked up on PATH) with `extra_environment` entries

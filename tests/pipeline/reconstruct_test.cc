@@ -13,6 +13,7 @@
 #include "pipeline/fusion.h"
 #include "pipeline/mesh_evaluation.h"
 #include "pipeline/ply.h"
+#include "pipeline/sgbm.h"
 #include "pipeline/textured_mesh.h"
 #include "tests/cli_runner.h"
 #include "pipeline/depth_evaluation.h"
@@ -136,6 +137,17 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_NE(assimp.output.find("Faces:"), std::string::npos) << assimp.output;
   EXPECT_NE(assimp.output.find(std::to_string(mesh.triangles.size())), std::string::npos)
       << assimp.output;
+
+  // The OpenCV StereoSGBM baseline on the same workspace (it overwrites depth/): it works on
+  // rectified pairs of these converging cameras, and PatchMatch beats it.
+  const MvsSummary sgbm_run =
+      RunSgbmStereo(workspace.Path(), MvsOptionsFor(Quality::kBalanced).views, {}, progress);
+  EXPECT_EQ(sgbm_run.views.size(), 12u);
+  const DepthEvaluation sgbm =
+      EvaluateDepth(model, workspace.Path() / "depth", truth, scene.Training().depth, {}, {});
+  EXPECT_GT(sgbm.completeness, 0.3);
+  EXPECT_LT(sgbm.abs_rel_median, 0.01);
+  EXPECT_LT(sgbm.within_2pct, depth.within_2pct);
 }
 
 TEST(Colmap, AFailingCommandNamesTheToolStatusAndLog) {
