@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/render_options.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/scene_folder.h"
@@ -102,7 +103,8 @@ nlohmann::json EvaluateMesh(const std::filesystem::path& obj, const SparseModel&
 // with gt_sources, from the scene's own training views and depth; compared with the novel
 // images.
 nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::path& workspace,
-                             bool gt_sources, const Similarity3d& truth_from_estimate) {
+                             bool gt_sources, const Similarity3d& truth_from_estimate,
+                             const RenderSettings& settings) {
   const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
   const Similarity3d estimate_from_truth =
       gt_sources ? Similarity3d{} : truth_from_estimate.Inverse();
@@ -117,8 +119,9 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
   SourceLibrary library(gt_sources ? scene.Training() : SourcePathsFor(workspace));
   const std::filesystem::path comparison_dir =
       workspace / "evaluation" / (gt_sources ? "novel_gt_sources" : "novel");
-  const NovelEvaluation result = EvaluateNovelViews(library, targets, names, scene.Novel(), {},
-                                                    {}, comparison_dir);
+  const NovelEvaluation result =
+      EvaluateNovelViews(library, targets, names, scene.Novel(), settings.selection,
+                         settings.render, comparison_dir);
   std::printf("novel views (%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels), SSIM %.3f; "
               "holes %.2f%% (cracks %.2f%%) -> %.2f%% after filling; out of view %.2f%%, "
               "background %.2f%%; %.1f ms per view; %d of %d sources loaded (%s)\n",
@@ -150,6 +153,8 @@ void RegisterEvaluateCommand(CLI::App& app) {
     std::filesystem::path json;
     bool no_align = false;
     bool gt_sources = false;
+    bool novel_only = false;
+    RenderSettings settings;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -170,8 +175,14 @@ void RegisterEvaluateCommand(CLI::App& app) {
   command->add_flag("--gt-sources", arguments->gt_sources,
                     "render the novel views from the scene's ground-truth cameras and depth "
                     "instead of the workspace's: measures the warp apart from the depth estimate");
+  command->add_flag("--novel-only", arguments->novel_only,
+                    "evaluate the novel views only (with --gt-sources the workspace only "
+                    "receives the comparison images)");
+  AddRenderOptions(*command, arguments->settings);
   command->callback([arguments] {
+    arguments->settings.Resolve();
     const SceneFolder scene{arguments->scene};
+
     const std::filesystem::path estimate_dir = arguments->workspace / "sparse";
     if (!DetectSparseFormat(estimate_dir)) {
       throw BadInputError(estimate_dir.string() + " holds no COLMAP model: run parallax "
@@ -185,7 +196,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     AddPoseSections(evaluation, json);
 
     const std::filesystem::path depth_dir = arguments->workspace / "depth";
-    if (HasDepthMaps(depth_dir)) {
+    if (HasDepthMaps(depth_dir) && !arguments->novel_only) {
       const std::filesystem::path error_image_dir =
           arguments->workspace / "evaluation" / "depth_error";
       const Similarity3d truth_from_estimate =
@@ -202,7 +213,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
       }
     }
     const std::filesystem::path fused = arguments->workspace / "fused.ply";
-    if (std::filesystem::exists(fused)) {
+    if (std::filesystem::exists(fused) && !arguments->novel_only) {
       const CloudAccuracy cloud = MeasureCloud(
           ReadPly(fused).vertices, truth, scene.Training().depth,
           arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source);
@@ -216,7 +227,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
                        {"within_1pct", cloud.within_1pct}};
     }
     const std::filesystem::path mesh_obj = arguments->workspace / "mesh" / "mesh.obj";
-    if (std::filesystem::exists(mesh_obj)) {
+    if (std::filesystem::exists(mesh_obj) && !arguments->novel_only) {
       json["mesh"] = EvaluateMesh(mesh_obj, estimate, arguments->workspace, truth, scene,
                                   arguments->no_align ? Similarity3d{}
                                                       : evaluation.alignment.target_from_source);
@@ -225,7 +236,8 @@ void RegisterEvaluateCommand(CLI::App& app) {
         (arguments->gt_sources || HasDepthMaps(depth_dir))) {
       json["novel"] = EvaluateNovel(
           scene, arguments->workspace, arguments->gt_sources,
-          arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source);
+          arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source,
+          arguments->settings);
     }
     const nlohmann::json timings = ReconstructTimings(arguments->workspace);
     if (!timings.is_null()) json["timings_s"] = timings;

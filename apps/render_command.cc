@@ -6,6 +6,7 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "apps/render_options.h"
 #include "apps/terminal_progress.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -63,8 +64,7 @@ void RegisterRenderCommand(CLI::App& app) {
     std::filesystem::path cameras;
     std::string path;
     std::filesystem::path out;
-    SourceSelectionOptions selection;
-    RenderOptions render;
+    RenderSettings settings;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -82,22 +82,11 @@ void RegisterRenderCommand(CLI::App& app) {
   cameras->excludes(path);
   path->excludes(cameras);
   command->add_option("--out", arguments->out, "output folder (created if missing)")->required();
-  command->add_option("--sources", arguments->selection.num_sources,
-                      "source views per target, the best K by overlap and angle (default 4)")
-      ->check(CLI::Range(1, 64));
-  const std::map<std::string, FillMethod> fills = {{"none", FillMethod::kNone},
-                                                   {"inpaint", FillMethod::kInpaint},
-                                                   {"depth-aware", FillMethod::kDepthAware}};
-  command->add_option("--fill", arguments->render.fill.method,
-                      "hole filling: none, inpaint (OpenCV Telea) or depth-aware (default)")
-      ->transform(CLI::CheckedTransformer(fills, CLI::ignore_case));
-  const std::map<std::string, WarpMethod> warps = {{"splat", WarpMethod::kSplat},
-                                                   {"mesh", WarpMethod::kMesh}};
-  command->add_option("--warp", arguments->render.warp.method,
-                      "forward warp: mesh (default; drops triangles across depth edges) or "
-                      "splat (points with a footprint)")
-      ->transform(CLI::CheckedTransformer(warps, CLI::ignore_case));
+  AddRenderOptions(*command, arguments->settings);
   command->callback([arguments] {
+    arguments->settings.Resolve();
+    const SourceSelectionOptions& selection = arguments->settings.selection;
+    const RenderOptions& render_options = arguments->settings.render;
     if (arguments->cameras.empty() && arguments->path.empty()) {
       throw CLI::ValidationError("render", "give the cameras: --cameras <model_dir> or --path <spec>");
     }
@@ -107,7 +96,7 @@ void RegisterRenderCommand(CLI::App& app) {
             ? CamerasAlongPath(arguments->path, library.Cameras(), library.Names())
             : CamerasFromModel(arguments->cameras);
     if (!std::filesystem::is_directory(arguments->input / "gt")) {
-      EstimateMissingDepth(arguments->input, library, targets, arguments->selection);
+      EstimateMissingDepth(arguments->input, library, targets, selection);
     }
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
@@ -115,7 +104,7 @@ void RegisterRenderCommand(CLI::App& app) {
     double hole_sum = 0, filled_sum = 0, ms_sum = 0;
     for (size_t i = 0; i < targets.size(); ++i) {
       const NovelView view =
-          RenderNovelView(library, targets[i], arguments->selection, arguments->render);
+          RenderNovelView(library, targets[i], selection, render_options);
       WriteNovelView(arguments->out, targets[i].name, view.result);
       csv += CsvRow(targets[i].name, view);
       hole_sum += view.result.metrics.hole_ratio;
