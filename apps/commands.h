@@ -9,9 +9,7 @@ void RegisterSynthCommand(CLI::App& app);
 void RegisterReconstructCommand(CLI::App& app);
 void RegisterEvaluateCommand(CLI::App& app);
 void RegisterRenderCommand(CLI::App& app);
-
-// A subcommand whose stage has not been built yet: it says so and exits with code 1.
-void RegisterPendingCommand(CLI::App& app, const std::string& name,
-                            const std::string& description);
+void RegisterBenchCommand(CLI::App& app);
+void RegisterViewCommand(CLI::App& app);
 
 }  // namespace parallax

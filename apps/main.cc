@@ -24,16 +24,6 @@ int PrintError(const char* message, int code) {
 
 }  // namespace
 
-void RegisterPendingCommand(CLI::App& app, const std::string& name,
-                            const std::string& description) {
-  CLI::App* command = app.add_subcommand(name, description + " (not yet available)");
-  command->allow_extras();
-  command->callback([name] {
-    throw std::invalid_argument("'parallax " + name +
-                                "' is not yet available in this version of parallax");
-  });
-}
-
 }  // namespace parallax
 
 int main(int argc, char** argv) {
@@ -48,8 +38,8 @@ int main(int argc, char** argv) {
   RegisterReconstructCommand(app);
   RegisterRenderCommand(app);
   RegisterEvaluateCommand(app);
-  RegisterPendingCommand(app, "view", "Shadowed, textured OpenGL viewer and screenshots");
-  RegisterPendingCommand(app, "bench", "Error against run time over a grid of settings");
+  RegisterViewCommand(app);
+  RegisterBenchCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

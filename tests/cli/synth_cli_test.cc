@@ -23,9 +23,8 @@ TEST(Cli, UsageErrorsExitOne) {
   EXPECT_EQ(RunParallax("no-such-command").exit_code, 1);
   EXPECT_EQ(RunParallax("synth").exit_code, 1);
   EXPECT_EQ(RunParallax("reconstruct a b --quality ultra").exit_code, 1);
-  const CliResult pending = RunParallax("bench scene out");
-  EXPECT_EQ(pending.exit_code, 1);
-  EXPECT_NE(pending.output.find("not yet available"), std::string::npos) << pending.output;
+  EXPECT_EQ(RunParallax("render scene --out o --fill blur").exit_code, 1);
+  EXPECT_EQ(RunParallax("bench").exit_code, 1);
 }
 
 TEST(Cli, SynthWithMalformedJsonExitsTwoNamingTheFileAndLine) {

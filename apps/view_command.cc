@@ -1,0 +1,180 @@
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "apps/commands.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "viewer/egl_context.h"
+#include "viewer/renderer.h"
+#include "viewer/view_cameras.h"
+#include "viewer/view_math.h"
+#include "viewer/viewer_scene.h"
+#include "viewer/window.h"
+
+namespace parallax {
+namespace {
+
+struct ViewArguments {
+  std::filesystem::path workspace;
+  std::filesystem::path screenshot;
+  std::string camera;
+  std::optional<double> orbit_deg;
+  double elevation_deg = 30;
+  double fov_deg = 50;
+  std::string size;  // "WxH"
+  std::string light = "45,50";  // Azimuth, elevation (degrees) of a directional light.
+  std::string point_light;      // "x,y,z" (world): a point light instead.
+  ShadowMode shadows = ShadowMode::kPcf;
+  TextureMode texture = TextureMode::kAtlas;
+  RenderSettings settings;
+  bool no_cameras = false;
+  bool no_grid = false;
+};
+
+std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
+  std::vector<double> values;
+  std::stringstream stream(text);
+  for (std::string item; std::getline(stream, item, ',');) {
+    try {
+      size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument(option + " " + text + ": '" + item + "' is not a number");
+    }
+  }
+  if (values.size() != count) {
+    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) + " comma-separated numbers");
+  }
+  return values;
+}
+
+std::pair<int, int> ParseSize(const std::string& text) {
+  int width = 0, height = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &extra) != 3 || x != 'x' || width < 16 ||
+      height < 16 || width > 16384 || height > 16384) {
+    throw std::invalid_argument("--size " + text + ": expected WxH with 16..16384 pixels per side, e.g. 1280x720");
+  }
+  return {width, height};
+}
+
+RenderSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
+  RenderSettings settings = a.settings;
+  settings.shadows = a.shadows;
+  settings.texture = a.texture;
+  settings.show_cameras = !a.no_cameras;
+  settings.show_grid = !a.no_grid;
+  if (!a.point_light.empty()) {
+    const std::vector<double> p = ParseNumbers(a.point_light, 3, "--point-light");
+    settings.light.type = LightKind::kPoint;
+    settings.light.position = Eigen::Vector3d(p[0], p[1], p[2]);
+    // Irradiance 1 at the scene's centre, like the default directional light.
+    settings.light.intensity = static_cast<float>((settings.light.position - scene.Centre().cast<double>()).squaredNorm());
+  } else {
+    const std::vector<double> angles = ParseNumbers(a.light, 2, "--light");
+    settings.light.direction = LightDirectionFromAngles(scene.up, angles[0], angles[1]);
+  }
+  settings.Check();
+  return settings;
+}
+
+std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name) {
+  if (name.empty()) return std::nullopt;
+  SourceViewCamera(scene, name);  // Throws with the known names when there is none.
+  for (size_t i = 0; i < scene.sources.size(); ++i) {
+    if (scene.sources[i].name == name || std::filesystem::path(scene.sources[i].name).stem() == name) {
+      return static_cast<int>(i);
+    }
+  }
+  return std::nullopt;
+}
+
+void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const RenderSettings& settings) {
+  const std::optional<std::pair<int, int>> size =
+      a.size.empty() ? std::nullopt : std::optional(ParseSize(a.size));
+  ViewCamera view;
+  if (!a.camera.empty()) {
+    view = SourceViewCamera(scene, a.camera);
+    if (size) view = ScaledSourceViewCamera(scene.sources[*SourceIndex(scene, a.camera)], size->first, size->second);
+  } else {
+    const auto [width, height] = size.value_or(std::pair{1280, 720});
+    view = OrbitViewCamera(scene, a.orbit_deg.value_or(30), a.elevation_deg, width, height, a.fov_deg);
+  }
+  const HeadlessGlContext context;
+  Renderer renderer(scene);
+  const auto start = std::chrono::steady_clock::now();
+  const RenderResult result = renderer.Render(view, settings);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  for (const std::string& note : renderer.TakeNotes()) std::fprintf(stderr, "note: %s\n", note.c_str());
+  WriteImage(a.screenshot, result.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
+  std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), result.colour.Width(),
+              result.colour.Height(), ms);
+}
+
+}  // namespace
+
+void RegisterViewCommand(CLI::App& app) {
+  auto a = std::make_shared<ViewArguments>();
+  CLI::App* command = app.add_subcommand(
+      "view",
+      "Shadowed, textured OpenGL viewer of a workspace (mesh and/or fused cloud, source cameras); "
+      "--screenshot renders offscreen (EGL, no display needed) into a PNG.");
+  command->add_option("workspace", a->workspace, "workspace folder (mesh/mesh.obj and/or fused.ply, sparse/)")
+      ->required();
+  command->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
+  auto* camera = command->add_option("--camera", a->camera, "view from this source camera (image name or stem)");
+  command->add_option("--orbit", a->orbit_deg, "view from an orbit about the scene centre at this azimuth (degrees)")
+      ->excludes(camera);
+  command->add_option("--elevation", a->elevation_deg, "orbit elevation above the ground (degrees, default 30)");
+  command->add_option("--fov", a->fov_deg, "orbit camera's horizontal field of view (degrees, default 50)")
+      ->check(CLI::Range(1.0, 170.0));
+  command->add_option("--size", a->size, "image size WxH (default 1280x720; a source camera's own size)");
+  const std::map<std::string, ShadowMode> shadows{{"none", ShadowMode::kNone},
+                                                  {"planar", ShadowMode::kPlanar},
+                                                  {"map", ShadowMode::kMap},
+                                                  {"pcf", ShadowMode::kPcf}};
+  command->add_option("--shadows", a->shadows, "none|planar|map|pcf (default pcf)")
+      ->transform(CLI::CheckedTransformer(shadows, CLI::ignore_case));
+  const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
+                                                    {"projective", TextureMode::kProjective},
+                                                    {"shaded", TextureMode::kShaded}};
+  command->add_option("--texture", a->texture, "atlas|projective|shaded (default atlas)")
+      ->transform(CLI::CheckedTransformer(textures, CLI::ignore_case));
+  command->add_option("--light", a->light, "directional light azimuth,elevation in degrees (default 45,50)");
+  command->add_option("--point-light", a->point_light, "a point light at x,y,z (world) instead");
+  command->add_option("--exposure", a->settings.exposure_stops, "exposure in stops (default 0)");
+  command->add_option("--shadow-map-size", a->settings.shadow_map_size, "shadow map side in texels (default 2048)")
+      ->check(CLI::Range(64, 8192));
+  command->add_option("--pcf-radius", a->settings.pcf_radius, "PCF kernel radius in texels (default 1)")
+      ->check(CLI::Range(0, 4));
+  command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
+  command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
+  command->callback([a] {
+    const ViewerScene scene = LoadViewerScene(a->workspace);
+    const RenderSettings settings = Settings(*a, scene);
+    if (!a->screenshot.empty()) {
+      TakeScreenshot(*a, scene, settings);
+      return;
+    }
+    WindowOptions options;
+    if (!a->size.empty()) std::tie(options.width, options.height) = ParseSize(a->size);
+    options.fov_deg = a->fov_deg;
+    options.azimuth_deg = a->orbit_deg.value_or(30);
+    options.elevation_deg = a->elevation_deg;
+    RunViewerWindow(scene, settings, options, SourceIndex(scene, a->camera),
+                    [](const std::string& text) {
+                      std::fputs(text.c_str(), stdout);
+                      std::fflush(stdout);
+                    });
+  });
+}
+
+}  // namespace parallax

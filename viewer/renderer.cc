@@ -1,0 +1,662 @@
+#include "viewer/renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <tuple>
+#include <stdexcept>
+#include <string_view>
+
+#include "viewer/gl.h"
+#include "viewer/shaders.h"
+#include "viewer/view_math.h"
+
+namespace parallax {
+namespace {
+
+constexpr int kMaxProjectors = 3;
+// Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7. Textures are
+// created on a unit of their own, so making one never disturbs what a sampler is bound to.
+constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5;
+constexpr int kScratchUnit = 15;
+
+GlTexture MakeTextureOnScratchUnit() {
+  glActiveTexture(GL_TEXTURE0 + kScratchUnit);
+  GlTexture texture = MakeGlTexture();
+  glBindTexture(GL_TEXTURE_2D, texture.Get());
+  return texture;
+}
+
+// One vertex of every buffer the viewer draws; unused attributes stay zero.
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+  float colour[3];
+};
+
+bool HasExtension(std::string_view name) {
+  GLint count = 0;
+  glGetIntegerv(GL_NUM_EXTENSIONS, &count);
+  for (GLint i = 0; i < count; ++i) {
+    if (name == reinterpret_cast<const char*>(glGetStringi(GL_EXTENSIONS, static_cast<GLuint>(i)))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// A vertex array over `vertices` with the attribute layout of the shaders.
+struct Drawable {
+  GlVertexArray vao;
+  GlBuffer buffer;
+  GLsizei count = 0;
+};
+
+Drawable Upload(const std::vector<Vertex>& vertices) {
+  Drawable d{MakeGlVertexArray(), MakeGlBuffer(), static_cast<GLsizei>(vertices.size())};
+  glBindVertexArray(d.vao.Get());
+  glBindBuffer(GL_ARRAY_BUFFER, d.buffer.Get());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
+               vertices.data(), GL_STATIC_DRAW);
+  const auto attribute = [](GLuint index, GLint size, size_t offset) {
+    glEnableVertexAttribArray(index);
+    glVertexAttribPointer(index, size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                          reinterpret_cast<const void*>(offset));
+  };
+  attribute(0, 3, offsetof(Vertex, position));
+  attribute(1, 3, offsetof(Vertex, normal));
+  attribute(2, 2, offsetof(Vertex, uv));
+  attribute(3, 3, offsetof(Vertex, colour));
+  glBindVertexArray(0);
+  return d;
+}
+
+// Three vertices per triangle so each carries its face normal (flat shading, no seams to
+// split) and its corner's atlas coordinate. The atlas is uploaded top row first, so t = 1 - v.
+// colour.x of a mesh vertex holds its triangle's greatest height above the ground, so planar
+// shadows can drop the ground's own triangles without also dropping the foot of a wall.
+std::vector<Vertex> MeshVertices(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground) {
+  std::vector<Vertex> vertices;
+  vertices.reserve(mesh.triangles.size() * 3);
+  const bool has_uv = mesh.corner_uvs.size() == mesh.triangles.size() * 3;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& tri = mesh.triangles[t];
+    Eigen::Vector3f normal =
+        (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
+    normal = normal.norm() > 0 ? Eigen::Vector3f(normal.normalized()) : Eigen::Vector3f::Zero();
+    float max_height = 0;
+    for (int c = 0; c < 3 && ground; ++c) {
+      max_height = std::max(max_height, static_cast<float>(ground->SignedDistance(mesh.vertices[tri[c]].cast<double>())));
+    }
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3f& p = mesh.vertices[tri[c]];
+      const Eigen::Vector2f uv = has_uv ? mesh.corner_uvs[3 * t + c] : Eigen::Vector2f(0.5f, 0.5f);
+      vertices.push_back({{p.x(), p.y(), p.z()}, {normal.x(), normal.y(), normal.z()},
+                          {uv.x(), 1 - uv.y()}, {max_height, 0, 0}});
+    }
+  }
+  return vertices;
+}
+
+std::vector<Vertex> PointVertices(const std::vector<ColouredPoint>& points) {
+  std::vector<Vertex> vertices;
+  vertices.reserve(points.size());
+  for (const ColouredPoint& p : points) {
+    vertices.push_back({{p.position.x(), p.position.y(), p.position.z()},
+                        {p.normal.x(), p.normal.y(), p.normal.z()},
+                        {0, 0},
+                        {p.colour[0] / 255.0f, p.colour[1] / 255.0f, p.colour[2] / 255.0f}});
+  }
+  return vertices;
+}
+
+void AddLine(std::vector<Vertex>& lines, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+             const Eigen::Vector3f& colour) {
+  for (const Eigen::Vector3d& p : {a, b}) {
+    lines.push_back({{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())},
+                     {0, 0, 0}, {0, 0}, {colour.x(), colour.y(), colour.z()}});
+  }
+}
+
+// Each source camera as a pyramid from its centre to its image corners at `depth`, with a
+// tick on the top edge so "up" is visible.
+std::vector<Vertex> FrustumLines(const std::vector<SourceView>& sources, double depth) {
+  std::vector<Vertex> lines;
+  const Eigen::Vector3f colour(0.9f, 0.45f, 0.1f);
+  for (const SourceView& source : sources) {
+    const Rigid3d world_from_cam = source.cam_from_world.Inverse();
+    const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
+    const double w = static_cast<double>(source.camera.width), h = static_cast<double>(source.camera.height);
+    Eigen::Vector3d corners[4];
+    const double pixels[4][2] = {{0, 0}, {w, 0}, {w, h}, {0, h}};
+    for (int i = 0; i < 4; ++i) {
+      const Eigen::Vector3d ray((pixels[i][0] - source.camera.PrincipalX()) / source.camera.FocalX(),
+                                (pixels[i][1] - source.camera.PrincipalY()) / source.camera.FocalY(), 1);
+      corners[i] = world_from_cam * (depth * ray);
+    }
+    for (int i = 0; i < 4; ++i) {
+      AddLine(lines, centre, corners[i], colour);
+      AddLine(lines, corners[i], corners[(i + 1) % 4], colour);
+    }
+    const Eigen::Vector3d top = 0.5 * (corners[0] + corners[1]);
+    AddLine(lines, top, top + 0.3 * (top - 0.5 * (corners[2] + corners[3])), colour);
+  }
+  return lines;
+}
+
+// A square grid on the ground (or, without one, under the scene, normal to `up`).
+std::vector<Vertex> GridLines(const ViewerScene& scene) {
+  const Eigen::Vector3d up = scene.up;
+  const Eigen::Vector3d centre = scene.Centre().cast<double>();
+  double height = 0;  // Of the grid plane along `up`, relative to the scene centre.
+  if (scene.ground) {
+    height = -scene.ground->SignedDistance(centre);
+  } else {
+    height = std::numeric_limits<double>::infinity();
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner =
+          scene.bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>();
+      height = std::min(height, up.dot(corner - centre));
+    }
+  }
+  // Just under the ground, so the ground mesh hides the grid instead of z-fighting with it.
+  const Eigen::Vector3d origin = centre + (height - 1e-3 * static_cast<double>(scene.Radius())) * up;
+  const Eigen::Vector3d reference = std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d u = (reference - up * up.dot(reference)).normalized();
+  const Eigen::Vector3d v = up.cross(u);
+  const double half = 1.5 * static_cast<double>(scene.Radius());
+  constexpr int kLines = 20;
+  std::vector<Vertex> lines;
+  const Eigen::Vector3f colour(0.55f, 0.55f, 0.55f);
+  for (int i = 0; i <= kLines; ++i) {
+    const double s = -half + 2 * half * i / kLines;
+    AddLine(lines, origin + s * u - half * v, origin + s * u + half * v, colour);
+    AddLine(lines, origin - half * u + s * v, origin + half * u + s * v, colour);
+  }
+  return lines;
+}
+
+void SetTextureParameters(GLenum filter, GLenum wrap) {
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, static_cast<GLint>(wrap));
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
+}
+
+// An sRGB texture of an image (values in [0, 1], sRGB-encoded), top row first; sampling returns
+// linear values.
+GlTexture UploadSrgbTexture(const Image& image) {
+  std::vector<uint8_t> bytes(static_cast<size_t>(image.Width()) * image.Height() * 3);
+  for (int y = 0; y < image.Height(); ++y) {
+    for (int x = 0; x < image.Width(); ++x) {
+      for (int c = 0; c < 3; ++c) {
+        const float value = image.At(x, y, std::min(c, image.Channels() - 1));
+        bytes[(static_cast<size_t>(y) * image.Width() + x) * 3 + c] =
+            static_cast<uint8_t>(std::lround(std::clamp(value, 0.0f, 1.0f) * 255));
+      }
+    }
+  }
+  GlTexture texture = MakeTextureOnScratchUnit();
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, image.Width(), image.Height(), 0, GL_RGB,
+               GL_UNSIGNED_BYTE, bytes.data());
+  glGenerateMipmap(GL_TEXTURE_2D);
+  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  return texture;
+}
+
+// A depth texture for hardware comparison, with an FBO that renders into it.
+struct DepthTarget {
+  GlTexture texture;
+  GlFramebuffer framebuffer;
+  int width = 0, height = 0;
+
+  void Resize(int new_width, int new_height) {
+    if (width == new_width && height == new_height && texture.Get() != 0) return;
+    width = new_width;
+    height = new_height;
+    texture = MakeTextureOnScratchUnit();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT,
+                 GL_FLOAT, nullptr);
+    SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_BORDER);
+    // Outside the map is lit: border depth 1 never occludes.
+    const float border[4] = {1, 1, 1, 1};
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    framebuffer = MakeGlFramebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, texture.Get(), 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw std::runtime_error("GL: depth framebuffer incomplete");
+    }
+  }
+};
+
+// The frame: sRGB-encoded colour (RGBA8), auxiliary float RGBA, float depth + stencil.
+struct EyeTarget {
+  GlFramebuffer framebuffer;
+  GlTexture colour, aux;
+  GlRenderbuffer depth_stencil;
+  int width = 0, height = 0;
+
+  void Resize(int new_width, int new_height) {
+    if (width == new_width && height == new_height && framebuffer.Get() != 0) return;
+    width = new_width;
+    height = new_height;
+    colour = MakeTextureOnScratchUnit();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
+    aux = MakeTextureOnScratchUnit();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+    SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
+    depth_stencil = MakeGlRenderbuffer();
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_stencil.Get());
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, width, height);
+    framebuffer = MakeGlFramebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour.Get(), 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, aux.Get(), 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
+                              depth_stencil.Get());
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      throw std::runtime_error("GL: frame buffer incomplete");
+    }
+  }
+};
+
+}  // namespace
+
+void RenderSettings::Check() const {
+  const auto fail = [](const std::string& field, const std::string& value) {
+    throw std::invalid_argument("RenderSettings::" + field + " is out of range: " + value);
+  };
+  if (shadow_map_size < 64 || shadow_map_size > 8192) fail("shadow_map_size (64..8192)", std::to_string(shadow_map_size));
+  if (pcf_radius < 0 || pcf_radius > 4) fail("pcf_radius (0..4)", std::to_string(pcf_radius));
+  if (projective_views < 1 || projective_views > kMaxProjectors) fail("projective_views (1..3)", std::to_string(projective_views));
+  if (!(point_size_px > 0)) fail("point_size_px (> 0)", std::to_string(point_size_px));
+  if (!std::isfinite(exposure_stops)) fail("exposure_stops (finite)", std::to_string(exposure_stops));
+  if (light.type == LightKind::kDirectional && !(light.direction.norm() > 0 && light.direction.allFinite())) {
+    fail("light.direction (finite, non-zero)", "");
+  }
+  if (!light.position.allFinite()) fail("light.position (finite)", "");
+}
+
+std::vector<int> NearestSourceViews(const ViewerScene& scene, const Eigen::Vector3d& eye, int count) {
+  const Eigen::Vector3d centre = scene.FocusCentre().cast<double>();
+  const Eigen::Vector3d to_eye = (eye - centre).normalized();
+  std::vector<std::pair<double, int>> scored;
+  for (size_t i = 0; i < scene.sources.size(); ++i) {
+    if (!std::filesystem::exists(scene.sources[i].image_path)) continue;
+    const Eigen::Vector3d to_source = (CameraCenter(scene.sources[i].cam_from_world) - centre).normalized();
+    scored.emplace_back(-to_eye.dot(to_source), static_cast<int>(i));
+  }
+  std::sort(scored.begin(), scored.end());
+  std::vector<int> nearest;
+  for (size_t i = 0; i < scored.size() && static_cast<int>(i) < count; ++i) nearest.push_back(scored[i].second);
+  return nearest;
+}
+
+struct Renderer::Impl {
+  const ViewerScene& scene;
+  bool reverse_z = false;  // glClipControl is available (and then always set to zero-to-one).
+  GlProgram depth, planar, lines;
+  std::map<std::tuple<int, int, int>, GlProgram> surface_programs;  // By (albedo, shadow mode, PCF radius).
+  // What this frame's surface programs need besides the settings.
+  Eigen::Matrix4f shadow_from_world = Eigen::Matrix4f::Identity();
+  Eigen::Matrix4f projector_from_world[kMaxProjectors];
+  Eigen::Vector3f projector_centre[kMaxProjectors];
+  Eigen::Vector4f ground_plane = Eigen::Vector4f::Zero();
+  float ground_tolerance = 0;
+  Drawable mesh, points, frusta, grid;
+  GlTexture atlas;
+  DepthTarget shadow;
+  DepthTarget projector_depth[kMaxProjectors];
+  std::map<int, GlTexture> photos;  // By source index, loaded on first use.
+  EyeTarget eye;
+  std::vector<std::string> notes;
+  bool planar_note_given = false;
+
+  explicit Impl(const ViewerScene& s) : scene(s) {}
+  DepthRange Range() const { return reverse_z ? DepthRange::kZeroToOne : DepthRange::kMinusOneToOne; }
+  Eigen::Vector2f NdcToDepth() const {
+    return reverse_z ? Eigen::Vector2f(1, 0) : Eigen::Vector2f(0.5f, 0.5f);
+  }
+  Eigen::Vector4d LightVector(const LightSettings& light) const {
+    if (light.type == LightKind::kPoint) return {light.position.x(), light.position.y(), light.position.z(), 1};
+    const Eigen::Vector3d towards = -light.direction.normalized();
+    return {towards.x(), towards.y(), towards.z(), 0};
+  }
+  Eigen::Matrix4f LightMatrix(const LightSettings& light) const {
+    return light.type == LightKind::kPoint ? PointLightMatrix(light.position, scene.bounds, Range())
+                                           : DirectionalLightMatrix(light.direction, scene.bounds, Range());
+  }
+  // What casts shadows and occludes projectors: the mesh when there is one, else the points.
+  void DrawCasters(const RenderSettings& settings, const GlProgram& program) {
+    if (mesh.count > 0) {
+      glBindVertexArray(mesh.vao.Get());
+      glDrawArrays(GL_TRIANGLES, 0, mesh.count);
+    } else if (points.count > 0) {
+      program.Set("u_point_size", settings.point_size_px);
+      glBindVertexArray(points.vao.Get());
+      glDrawArrays(GL_POINTS, 0, points.count);
+    }
+  }
+  void RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
+                      const RenderSettings& settings, float slope_bias);
+  GLuint Photo(int source);
+  int SetUpProjectors(const ViewCamera& view, const RenderSettings& settings);
+  const GlProgram& SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius);
+  void UseSurfaceProgram(const GlProgram& program, const ViewCamera& view, const RenderSettings& settings,
+                         const Eigen::Matrix4f& clip_from_world, int projectors);
+  void DrawSurfaces(const ViewCamera& view, const RenderSettings& settings,
+                    const Eigen::Matrix4f& clip_from_world, int shadow_mode, int projectors);
+  void DrawPlanarShadows(const ViewCamera& view, const RenderSettings& settings,
+                         const Eigen::Matrix4f& clip_from_world, int projectors);
+};
+
+void Renderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
+                                    const RenderSettings& settings, float slope_bias) {
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.Get());
+  glViewport(0, 0, target.width, target.height);
+  glDisable(GL_STENCIL_TEST);
+  glEnable(GL_DEPTH_TEST);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(GL_LESS);
+  glClearDepth(1.0);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  // Slope-scaled bias against acne: each depth is pushed back by its slope across a texel.
+  // No face culling: reconstructed meshes have no consistent winding.
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(slope_bias, 4.0f);
+  depth.Use();
+  depth.Set("u_clip_from_world", clip_from_world);
+  DrawCasters(settings, depth);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+}
+
+GLuint Renderer::Impl::Photo(int source) {
+  auto found = photos.find(source);
+  if (found == photos.end()) {
+    found = photos.emplace(source, UploadSrgbTexture(ReadImage(scene.sources[source].image_path))).first;
+  }
+  return found->second.Get();
+}
+
+// Renders each chosen source camera's depth map and binds its photo; returns how many.
+int Renderer::Impl::SetUpProjectors(const ViewCamera& view, const RenderSettings& settings) {
+  const std::vector<int> chosen =
+      NearestSourceViews(scene, CameraCenter(view.cam_from_world), settings.projective_views);
+  for (size_t k = 0; k < chosen.size(); ++k) {
+    const SourceView& source = scene.sources[chosen[k]];
+    const Eigen::Vector2d range = DepthBounds(scene.bounds, source.cam_from_world);
+    const Eigen::Matrix4f clip_from_world =
+        PerspectiveProjection(source.camera, range[0], range[1], Range()) * ViewMatrix(source.cam_from_world);
+    projector_depth[k].Resize(static_cast<int>(std::min<uint64_t>(source.camera.width, 4096)),
+                              static_cast<int>(std::min<uint64_t>(source.camera.height, 4096)));
+    RenderDepthMap(projector_depth[k], clip_from_world, settings, 0.0f);
+    const GLuint photo = Photo(chosen[k]);
+    glActiveTexture(GL_TEXTURE0 + kPhotoUnit + k);
+    glBindTexture(GL_TEXTURE_2D, photo);
+    glActiveTexture(GL_TEXTURE0 + kProjectorDepthUnit + k);
+    glBindTexture(GL_TEXTURE_2D, projector_depth[k].texture.Get());
+    projector_from_world[k] = clip_from_world;
+    projector_centre[k] = CameraCenter(source.cam_from_world).cast<float>();
+  }
+  glActiveTexture(GL_TEXTURE0);
+  return static_cast<int>(chosen.size());
+}
+
+const GlProgram& Renderer::Impl::SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius) {
+  if (shadow_mode != 3) pcf_radius = 0;
+  auto found = surface_programs.find({albedo_source, shadow_mode, pcf_radius});
+  if (found != surface_programs.end()) return found->second;
+  const std::string fragment = "#version 330 core\n#define ALBEDO_SOURCE " + std::to_string(albedo_source) +
+                               "\n#define SHADOW_MODE " + std::to_string(shadow_mode) +
+                               "\n#define PCF_RADIUS " + std::to_string(pcf_radius) + "\n" +
+                               shaders::kSurfaceFragment;
+  GlProgram program("surface", shaders::kSurfaceVertex, fragment.c_str());
+  program.Use();
+  program.Set("u_atlas", kAtlasUnit);
+  program.Set("u_shadow_map", kShadowUnit);
+  for (int k = 0; k < kMaxProjectors; ++k) {
+    program.Set(("u_photo" + std::to_string(k)).c_str(), kPhotoUnit + k);
+    program.Set(("u_projector_depth" + std::to_string(k)).c_str(), kProjectorDepthUnit + k);
+  }
+  return surface_programs.emplace(std::tuple{albedo_source, shadow_mode, pcf_radius}, std::move(program)).first->second;
+}
+
+void Renderer::Impl::UseSurfaceProgram(const GlProgram& program, const ViewCamera& view,
+                                       const RenderSettings& settings, const Eigen::Matrix4f& clip_from_world,
+                                       int projectors) {
+  program.Use();
+  program.Set("u_clip_from_world", clip_from_world);
+  program.Set("u_cam_from_world", ViewMatrix(view.cam_from_world));
+  program.Set("u_eye", Eigen::Vector3f(CameraCenter(view.cam_from_world).cast<float>()));
+  program.Set("u_light", Eigen::Vector4f(LightVector(settings.light).cast<float>()));
+  program.Set("u_light_colour", Eigen::Vector3f(settings.light.intensity * settings.light.colour));
+  program.Set("u_ambient", settings.ambient);
+  program.Set("u_specular", settings.specular);
+  program.Set("u_shininess", settings.shininess);
+  program.Set("u_exposure", std::exp2(settings.exposure_stops));
+  program.Set("u_ndc_to_depth", NdcToDepth());
+  program.Set("u_shadow_from_world", shadow_from_world);
+  program.Set("u_num_projectors", projectors);
+  program.Set("u_projector_pull", 0.003f);
+  for (int k = 0; k < projectors; ++k) {
+    const std::string index = std::to_string(k);
+    program.Set(("u_projector_from_world[" + index + "]").c_str(), projector_from_world[k]);
+    program.Set(("u_projector_centre[" + index + "]").c_str(), projector_centre[k]);
+  }
+  program.Set("u_has_atlas", atlas.Get() != 0 ? 1 : 0);
+  program.Set("u_ground", ground_plane);
+  program.Set("u_ground_tolerance", ground_tolerance);
+  program.Set("u_point_size", settings.point_size_px);
+}
+
+void Renderer::Impl::DrawSurfaces(const ViewCamera& view, const RenderSettings& settings,
+                                  const Eigen::Matrix4f& clip_from_world, int shadow_mode,
+                                  int projectors) {
+  const int albedo = settings.texture == TextureMode::kProjective ? 1
+                     : settings.texture == TextureMode::kShaded ? 2
+                                                               : 0;
+  if (settings.show_mesh && mesh.count > 0) {
+    UseSurfaceProgram(SurfaceProgram(albedo == 0 && atlas.Get() == 0 ? 2 : albedo, shadow_mode, settings.pcf_radius), view, settings,
+                      clip_from_world, projectors);
+    glBindVertexArray(mesh.vao.Get());
+    glDrawArrays(GL_TRIANGLES, 0, mesh.count);
+  }
+  if (settings.show_points && points.count > 0 &&
+      (mesh.count == 0 || !settings.show_mesh || settings.points_with_mesh)) {
+    UseSurfaceProgram(SurfaceProgram(albedo == 0 ? 3 : albedo, shadow_mode, settings.pcf_radius), view, settings, clip_from_world,
+                      projectors);
+    glBindVertexArray(points.vao.Get());
+    glDrawArrays(GL_POINTS, 0, points.count);
+  }
+}
+
+// Planar shadows: mark in the stencil the pixels covered by the geometry flattened onto the
+// ground along the light (each pixel once, however many casters overlap: no double darkening),
+// then redraw the ground there unlit.
+void Renderer::Impl::DrawPlanarShadows(const ViewCamera& view, const RenderSettings& settings,
+                                       const Eigen::Matrix4f& clip_from_world, int projectors) {
+  const GroundPlane& ground = *scene.ground;
+  const Eigen::Vector4f plane(static_cast<float>(ground.normal.x()), static_cast<float>(ground.normal.y()),
+                              static_cast<float>(ground.normal.z()), static_cast<float>(ground.offset));
+  // Ground within this distance of the plane receives planar shadows; triangles reaching
+  // higher cast them.
+  const float tolerance = 0.01f * scene.FocusRadius();
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glDisable(GL_DEPTH_TEST);  // The redraw below tests depth against the real ground.
+  planar.Use();
+  planar.Set("u_clip_from_world", clip_from_world);
+  planar.Set("u_planar_shadow", PlanarShadowMatrix(ground, LightVector(settings.light)));
+  planar.Set("u_ground", plane);
+  planar.Set("u_ground_tolerance", tolerance);
+  planar.Set("u_points", mesh.count == 0 ? 1 : 0);
+  DrawCasters(settings, planar);
+
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glStencilFunc(GL_EQUAL, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(reverse_z ? GL_GEQUAL : GL_LEQUAL);  // Same geometry, same depth: passes.
+  ground_plane = plane;
+  ground_tolerance = tolerance;
+  DrawSurfaces(view, settings, clip_from_world, /*planar second pass*/ 1, projectors);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_STENCIL_TEST);
+}
+
+Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
+  Impl& r = *impl_;
+  r.reverse_z = HasExtension("GL_ARB_clip_control");
+  if (r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  r.depth = GlProgram("depth", shaders::kDepthVertex, shaders::kDepthFragment);
+  r.planar = GlProgram("planar shadow", shaders::kPlanarVertex, shaders::kPlanarFragment);
+  r.lines = GlProgram("lines", shaders::kLineVertex, shaders::kLineFragment);
+  if (!scene.mesh.triangles.empty()) r.mesh = Upload(MeshVertices(scene.mesh, scene.ground));
+  if (!scene.points.empty()) r.points = Upload(PointVertices(scene.points));
+  if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, 0.12 * static_cast<double>(scene.FocusRadius())));
+  r.grid = Upload(GridLines(scene));
+  if (!scene.mesh.atlas.Empty()) r.atlas = UploadSrgbTexture(scene.mesh.atlas);
+
+  // Samplers must hold textures of their type even when unused: give the comparison samplers
+  // a 1x1 depth map each.
+  r.shadow.Resize(1, 1);
+  for (DepthTarget& target : r.projector_depth) target.Resize(1, 1);
+  glEnable(GL_PROGRAM_POINT_SIZE);
+  CheckGlError("Renderer setup");
+}
+
+Renderer::~Renderer() = default;
+
+bool Renderer::UsesReverseZ() const { return impl_->reverse_z; }
+
+std::vector<std::string> Renderer::TakeNotes() { return std::exchange(impl_->notes, {}); }
+
+void Renderer::Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer) {
+  settings.Check();
+  Impl& r = *impl_;
+  const bool reverse_z = r.reverse_z && settings.reverse_z;
+  const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
+
+  // 1. Shadow map from the light.
+  int shadow_mode_uniform = 0;
+  if (settings.shadows == ShadowMode::kMap || settings.shadows == ShadowMode::kPcf) {
+    const Eigen::Matrix4f light_matrix = r.LightMatrix(settings.light);
+    r.shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
+    // PCF taps up to r texels away compare against the centre's depth: more slope bias.
+    const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + settings.pcf_radius : 1.5f;
+    r.RenderDepthMap(r.shadow, light_matrix, settings, slope_bias);
+    r.shadow_from_world = light_matrix;
+    shadow_mode_uniform = settings.shadows == ShadowMode::kMap ? 2 : 3;
+  }
+  glActiveTexture(GL_TEXTURE0 + kShadowUnit);
+  glBindTexture(GL_TEXTURE_2D, r.shadow.texture.Get());
+  glActiveTexture(GL_TEXTURE0 + kAtlasUnit);
+  glBindTexture(GL_TEXTURE_2D, r.atlas.Get());
+
+  // 2. Projectors' depth maps and photos.
+  int projectors = 0;
+  if (settings.texture == TextureMode::kProjective) projectors = r.SetUpProjectors(view, settings);
+
+  // 3. The frame.
+  r.eye.Resize(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, r.eye.framebuffer.Get());
+  glViewport(0, 0, width, height);
+  const Eigen::Vector3f background(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
+                                   LinearToSrgb(settings.background.z()));
+  const float clear_colour[4] = {background.x(), background.y(), background.z(), 1};
+  const float clear_aux[4] = {1, 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 0, clear_colour);
+  glClearBufferfv(GL_COLOR, 1, clear_aux);
+  glClearDepth(reverse_z ? 0.0 : 1.0);
+  glClearStencil(0);
+  glDepthMask(GL_TRUE);
+  glStencilMask(0xff);
+  glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(reverse_z ? GL_GREATER : GL_LESS);
+
+  Eigen::Matrix4f projection;
+  if (reverse_z) {
+    const double near = view.near > 0 ? view.near : DepthBounds(r.scene.bounds, view.cam_from_world)[0];
+    projection = ReverseZProjection(view.camera, near);
+  } else {
+    // Without reverse-Z the depth range is fitted to what can be seen: the scene's bounds.
+    Eigen::Vector2d range = DepthBounds(r.scene.bounds, view.cam_from_world);
+    if (view.near > 0) range[0] = view.near;
+    projection = PerspectiveProjection(view.camera, range[0], std::max(range[1], 4 * range[0]), r.Range());
+  }
+  const Eigen::Matrix4f clip_from_world = projection * ViewMatrix(view.cam_from_world);
+  if (!reverse_z && r.reverse_z) {
+    // glClipControl is global; this frame's projection uses [-1, 1].
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+  }
+  r.DrawSurfaces(view, settings, clip_from_world, shadow_mode_uniform, projectors);
+  if (settings.shadows == ShadowMode::kPlanar) {
+    if (r.scene.ground) {
+      r.DrawPlanarShadows(view, settings, clip_from_world, projectors);
+    } else if (!r.planar_note_given) {
+      r.notes.push_back("planar shadows skipped: no ground plane was found in the scene");
+      r.planar_note_given = true;
+    }
+  }
+  r.lines.Use();
+  r.lines.Set("u_clip_from_world", clip_from_world);
+  if (settings.show_grid) {
+    glBindVertexArray(r.grid.vao.Get());
+    glDrawArrays(GL_LINES, 0, r.grid.count);
+  }
+  if (settings.show_cameras && r.frusta.count > 0) {
+    glBindVertexArray(r.frusta.vao.Get());
+    glDrawArrays(GL_LINES, 0, r.frusta.count);
+  }
+  glBindVertexArray(0);
+  if (!reverse_z && r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+
+  if (window_framebuffer >= 0) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, r.eye.framebuffer.Get());
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(window_framebuffer));
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  CheckGlError("Renderer::Draw");
+}
+
+RenderResult Renderer::Render(const ViewCamera& view, const RenderSettings& settings) {
+  Draw(view, settings);
+  const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->eye.framebuffer.Get());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  std::vector<uint8_t> bytes(static_cast<size_t>(width) * height * 4);
+  std::vector<float> aux(static_cast<size_t>(width) * height * 4);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aux.data());
+  CheckGlError("Renderer::Render read back");
+  RenderResult result{Image(width, height, 3), Image(width, height, 4)};
+  for (int y = 0; y < height; ++y) {
+    const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < 3; ++c) result.colour.At(x, y, c) = bytes[(row + x) * 4 + c] / 255.0f;
+      for (int c = 0; c < 4; ++c) result.aux.At(x, y, c) = aux[(row + x) * 4 + c];
+    }
+  }
+  return result;
+}
+
+}  // namespace parallax

@@ -1,0 +1,111 @@
+#pragma once
+// The OpenGL renderer of the viewer: one code path for the window and for offscreen images.
+// Every frame is drawn into the renderer's own framebuffer (sRGB-encoded colour, a float
+// auxiliary target, 32-bit float depth + stencil); the window blits it to the screen, the
+// offscreen path reads it back.
+//
+// Needs a current OpenGL 3.3 core context (HeadlessGlContext or a GLFW window) for its whole
+// life. Depth uses reverse-Z (glClipControl, GL 4.5 / ARB_clip_control, which llvmpipe has)
+// with an infinite far plane; without it, near and far are fitted to the scene's bounds.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/pose.h"
+#include "viewer/viewer_scene.h"
+
+namespace parallax {
+
+enum class ShadowMode {
+  kNone,
+  kPlanar,  // Geometry flattened onto the fitted ground along the light, stencil-masked.
+  kMap,     // Shadow map, hardware depth comparison (bilinear between 4 texels).
+  kPcf,     // Shadow map filtered over a (2r+1)^2 kernel.
+};
+
+enum class TextureMode {
+  kAtlas,       // The mesh's texture atlas (points: their colours), lit.
+  kProjective,  // Source photos projected from their cameras, shown as captured.
+  kShaded,      // Uniform grey albedo, lit: shows the geometry and the shadows.
+};
+
+enum class LightKind { kDirectional, kPoint };
+
+struct LightSettings {
+  LightKind type = LightKind::kDirectional;
+  Eigen::Vector3d direction = Eigen::Vector3d(-0.4, -0.3, -0.87);  // Directional: travel direction (world).
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();              // Point light (world).
+  Eigen::Vector3f colour{1, 1, 1};  // Linear RGB.
+  float intensity = 1;  // Irradiance (directional) or intensity (point, falls off as 1/d^2).
+};
+
+struct RenderSettings {
+  ShadowMode shadows = ShadowMode::kPcf;
+  TextureMode texture = TextureMode::kAtlas;
+  LightSettings light;
+  float ambient = 0.2f;           // Ambient irradiance, linear.
+  float specular = 0.15f;         // Blinn-Phong specular weight.
+  float shininess = 32;           // Blinn-Phong exponent.
+  float exposure_stops = 0;       // Linear colour is scaled by 2^stops before sRGB encoding.
+  int shadow_map_size = 2048;     // Shadow map side in texels, 64..8192.
+  int pcf_radius = 1;             // PCF kernel radius in texels (kernel 2r+1 square), 0..4.
+  int projective_views = 3;       // Source photos blended in projective mode, 1..3.
+  bool show_mesh = true;
+  bool show_points = true;        // The fused cloud (drawn only when there is no mesh unless set).
+  bool points_with_mesh = false;  // Draw the cloud even when a mesh is present.
+  bool show_cameras = true;       // Source cameras as frusta.
+  bool show_grid = true;          // Grid on the ground plane.
+  float point_size_px = 2;
+  bool reverse_z = true;          // Use reverse-Z where glClipControl exists.
+  Eigen::Vector3f background{0.32f, 0.36f, 0.42f};  // Linear RGB.
+  void Check() const;             // Throws std::invalid_argument naming the field.
+};
+
+// Where the frame is seen from. The camera is used as a pinhole (distortion ignored).
+struct ViewCamera {
+  Camera camera;
+  Rigid3d cam_from_world;
+  double near = 0;  // Near plane (scene units); 0 fits it to the scene bounds.
+};
+
+struct RenderResult {
+  Image colour;  // sRGB-encoded RGB, top row first.
+  // Per pixel: light visibility in [0, 1] (1 lit; shadow map/PCF/planar), n.l (the normal
+  // turned towards the eye), eye z-depth, coverage (1 where a surface was drawn).
+  Image aux;
+};
+
+class Renderer {
+ public:
+  // Uploads the scene. Throws std::runtime_error if a shader does not compile or GL fails.
+  explicit Renderer(const ViewerScene& scene);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Draws one frame of the view's camera size into the internal framebuffer and, when
+  // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer).
+  void Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer = -1);
+
+  // Draws and reads the frame back.
+  RenderResult Render(const ViewCamera& view, const RenderSettings& settings);
+
+  bool UsesReverseZ() const;
+  // Messages for the user, e.g. that planar shadows are skipped without a ground plane.
+  std::vector<std::string> TakeNotes();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The source views to project for an eye at `eye`: up to `count` indices into scene.sources,
+// with a photo on disk, nearest by the angle their centres make with the eye at the scene
+// centre.
+std::vector<int> NearestSourceViews(const ViewerScene& scene, const Eigen::Vector3d& eye, int count);
+
+}  // namespace parallax

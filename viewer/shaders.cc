@@ -1,0 +1,240 @@
+#include "viewer/shaders.h"
+
+namespace parallax::shaders {
+
+const char* const kSurfaceVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_uv;
+layout(location = 3) in vec3 a_colour;  // sRGB in [0, 1] (points); unused for the mesh.
+uniform mat4 u_clip_from_world;
+uniform mat4 u_cam_from_world;
+uniform float u_point_size;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+out vec3 v_colour;
+out float v_eye_depth;
+void main() {
+  v_world = a_position;
+  v_normal = a_normal;
+  v_uv = a_uv;
+  v_colour = a_colour;
+  v_eye_depth = (u_cam_from_world * vec4(a_position, 1.0)).z;
+  gl_PointSize = u_point_size;
+  gl_Position = u_clip_from_world * vec4(a_position, 1.0);
+}
+)";
+
+const char* const kSurfaceFragment = R"(
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in vec3 v_colour;
+in float v_eye_depth;
+layout(location = 0) out vec4 o_colour;
+layout(location = 1) out vec4 o_aux;  // visibility, n.l, eye depth, coverage
+
+// Compile-time constants: one program per combination, so llvmpipe runs no dead branches
+// (a single program with uniform switches ran 6x slower).
+const int u_albedo_source = ALBEDO_SOURCE;  // 0 atlas, 1 projective, 2 constant grey, 3 vertex colour
+uniform sampler2D u_atlas;
+uniform bool u_has_atlas;
+uniform vec3 u_eye;
+uniform vec4 u_light;         // (towards-light direction, 0) or (position, 1)
+uniform vec3 u_light_colour;  // Irradiance (directional) or intensity (point), linear RGB.
+uniform float u_ambient;
+uniform float u_specular;
+uniform float u_shininess;
+uniform float u_exposure;     // Linear scale, 2^stops.
+
+const int u_shadow_mode = SHADOW_MODE;      // 0 none, 1 planar (second pass), 2 map, 3 pcf
+uniform sampler2DShadow u_shadow_map;
+uniform mat4 u_shadow_from_world;
+uniform vec2 u_ndc_to_depth;  // window depth = ndc.z * x + y
+const int u_pcf_radius = PCF_RADIUS;
+uniform vec4 u_ground;        // Plane (n, d) for the planar shadow pass.
+uniform float u_ground_tolerance;
+
+uniform int u_num_projectors;
+uniform sampler2D u_photo0;
+uniform sampler2D u_photo1;
+uniform sampler2D u_photo2;
+uniform sampler2DShadow u_projector_depth0;
+uniform sampler2DShadow u_projector_depth1;
+uniform sampler2DShadow u_projector_depth2;
+uniform mat4 u_projector_from_world[3];
+uniform vec3 u_projector_centre[3];
+uniform float u_projector_pull;  // Fraction of the distance, e.g. 0.003.
+
+vec3 SrgbToLinear(vec3 c) {
+  return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+vec3 LinearToSrgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+
+// 1 lit, 0 shadowed. Hardware comparison gives a bilinearly filtered 0/1 per tap; outside the
+// light's frustum the border depth 1 reads as lit.
+float ShadowVisibility() {
+  vec4 clip = u_shadow_from_world * vec4(v_world, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec3 ndc = clip.xyz / clip.w;
+  vec3 coord = vec3(ndc.xy * 0.5 + 0.5, ndc.z * u_ndc_to_depth.x + u_ndc_to_depth.y);
+  if (u_shadow_mode == 2) return texture(u_shadow_map, coord);
+  vec2 texel = 1.0 / vec2(textureSize(u_shadow_map, 0));
+  float sum = 0.0;
+  int r = u_pcf_radius;
+  for (int y = -r; y <= r; ++y) {
+    for (int x = -r; x <= r; ++x) {
+      sum += texture(u_shadow_map, vec3(coord.xy + vec2(x, y) * texel, coord.z));
+    }
+  }
+  return sum / float((2 * r + 1) * (2 * r + 1));
+}
+
+// A photo projected like a slide: its colour and a weight, zero where the projector's depth
+// map says the surface is hidden from that camera, or outside its image.
+vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, vec3 centre,
+             vec3 view_dir) {
+  vec4 clip = projector_from_world * vec4(v_world, 1.0);
+  if (clip.w <= 0.0) return vec4(0.0);
+  vec3 ndc = clip.xyz / clip.w;
+  if (any(greaterThan(abs(ndc), vec3(1.0)))) return vec4(0.0);
+  vec2 uv = ndc.xy * 0.5 + 0.5;
+  // Visibility bias relative to the distance: the point is pulled a small fraction of the way
+  // towards the projector. A slope-scaled polygon offset would push silhouettes behind the
+  // surfaces they hide and let photos of the occluder leak onto them.
+  vec4 pulled = projector_from_world * vec4(mix(v_world, centre, u_projector_pull), 1.0);
+  float ref = (pulled.z / pulled.w) * u_ndc_to_depth.x + u_ndc_to_depth.y;
+  if (texture(depth, vec3(uv, ref)) < 0.5) return vec4(0.0);
+  // Views whose ray to the point is close to the eye's ray get the weight.
+  float cosine = max(dot(normalize(centre - v_world), view_dir), 0.0);
+  float weight = pow(cosine, 64.0) + 1e-6;
+  // Photos are stored top row first; t = 1 - v / H flips into texture coordinates.
+  vec3 colour = texture(photo, vec2(uv.x, 1.0 - uv.y)).rgb;
+  return vec4(colour * weight, weight);
+}
+
+void main() {
+  vec3 view_dir = normalize(u_eye - v_world);
+  vec3 n = length(v_normal) > 0.0 ? normalize(v_normal) : view_dir;
+  // Windings of reconstructed meshes are not consistent: light the side the eye sees.
+  if (dot(n, view_dir) < 0.0) n = -n;
+
+  vec3 to_light = u_light.xyz;
+  vec3 irradiance = u_light_colour;
+  if (u_light.w > 0.5) {
+    to_light = u_light.xyz - v_world;
+    float d2 = max(dot(to_light, to_light), 1e-20);
+    irradiance /= d2;
+  }
+  to_light = normalize(to_light);
+  float n_dot_l = dot(n, to_light);
+
+  float visibility = 1.0;
+  if (u_shadow_mode == 1) {
+    // Second pass of planar shadows: redraw only where the ground lies under a flattened caster.
+    float height = dot(u_ground.xyz, v_world) + u_ground.w;
+    if (abs(height) > u_ground_tolerance) discard;
+    visibility = 0.0;
+  } else if (u_shadow_mode >= 2 && n_dot_l > 0.0) {
+    visibility = ShadowVisibility();
+  }
+
+  vec3 albedo = vec3(0.7);
+  bool relight = true;
+  if (u_albedo_source == 0) {
+    albedo = SrgbToLinear(texture(u_atlas, v_uv).rgb);
+  } else if (u_albedo_source == 3) {
+    albedo = SrgbToLinear(v_colour);
+  } else if (u_albedo_source == 1) {
+    vec4 sum = Project(u_photo0, u_projector_depth0, u_projector_from_world[0], u_projector_centre[0], view_dir);
+    if (u_num_projectors > 1) sum += Project(u_photo1, u_projector_depth1, u_projector_from_world[1], u_projector_centre[1], view_dir);
+    if (u_num_projectors > 2) sum += Project(u_photo2, u_projector_depth2, u_projector_from_world[2], u_projector_centre[2], view_dir);
+    if (sum.w > 0.0) {
+      // Photos already hold the scene's lighting and shadows: show them as captured.
+      albedo = sum.rgb / sum.w;
+      relight = false;
+    } else if (u_has_atlas) {
+      albedo = SrgbToLinear(texture(u_atlas, v_uv).rgb);  // No photo sees this surface.
+    }
+  }
+
+  vec3 colour = albedo;
+  if (relight) {
+    float lit = visibility * max(n_dot_l, 0.0);
+    vec3 h = normalize(to_light + view_dir);
+    float highlight = n_dot_l > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
+    colour = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * u_specular * highlight * irradiance;
+  }
+  o_colour = vec4(LinearToSrgb(colour * u_exposure), 1.0);
+  o_aux = vec4(visibility, n_dot_l, v_eye_depth, 1.0);
+}
+)";
+
+const char* const kDepthVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_clip_from_world;
+uniform float u_point_size;
+void main() {
+  gl_PointSize = u_point_size;
+  gl_Position = u_clip_from_world * vec4(a_position, 1.0);
+}
+)";
+
+const char* const kDepthFragment = R"(#version 330 core
+void main() {}
+)";
+
+const char* const kPlanarVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 3) in vec3 a_colour;  // Mesh: x = the triangle's greatest height.
+uniform mat4 u_clip_from_world;
+uniform mat4 u_planar_shadow;  // Flattens onto the ground along the light.
+uniform vec4 u_ground;
+uniform float u_point_size;
+uniform bool u_points;
+out float v_height;
+void main() {
+  // Whole triangles cast (the foot of a box too); a point casts by its own height.
+  v_height = u_points ? dot(u_ground.xyz, a_position) + u_ground.w : a_colour.x;
+  gl_PointSize = u_point_size;
+  gl_Position = u_clip_from_world * (u_planar_shadow * vec4(a_position, 1.0));
+}
+)";
+
+const char* const kPlanarFragment = R"(#version 330 core
+in float v_height;
+uniform float u_ground_tolerance;
+void main() {
+  // The ground itself (and anything under it) casts no planar shadow onto the ground. The
+  // value is constant over a triangle: no fragment of a standing triangle is dropped.
+  if (v_height < u_ground_tolerance) discard;
+}
+)";
+
+const char* const kLineVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 3) in vec3 a_colour;  // Linear RGB.
+uniform mat4 u_clip_from_world;
+out vec3 v_colour;
+void main() {
+  v_colour = a_colour;
+  gl_Position = u_clip_from_world * vec4(a_position, 1.0);
+}
+)";
+
+const char* const kLineFragment = R"(#version 330 core
+in vec3 v_colour;
+layout(location = 0) out vec4 o_colour;
+layout(location = 1) out vec4 o_aux;
+void main() {
+  vec3 c = clamp(v_colour, 0.0, 1.0);
+  o_colour = vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
+  o_aux = vec4(1.0, 1.0, 0.0, 0.0);  // Not a surface.
+}
+)";
+
+}  // namespace parallax::shaders

@@ -1,0 +1,24 @@
+#pragma once
+// GLSL 3.30 sources of the viewer's programs (raw string literals in shaders.cc).
+namespace parallax::shaders {
+
+// Surfaces (mesh triangles and point sprites): Blinn-Phong in linear light, shadow map or PCF,
+// projective texturing, exposure, sRGB output; a second output carries light visibility,
+// n.l, eye depth and coverage for tests. The fragment shader has no #version line: prefix it
+// with "#version 330 core" and #defines of ALBEDO_SOURCE, SHADOW_MODE and PCF_RADIUS.
+extern const char* const kSurfaceVertex;
+extern const char* const kSurfaceFragment;
+
+// Depth only, from a light or a projector.
+extern const char* const kDepthVertex;
+extern const char* const kDepthFragment;
+
+// Geometry flattened onto the ground along the light (planar shadows, stencil marking).
+extern const char* const kPlanarVertex;
+extern const char* const kPlanarFragment;
+
+// Coloured lines: camera frusta and the ground grid.
+extern const char* const kLineVertex;
+extern const char* const kLineFragment;
+
+}  // namespace parallax::shaders

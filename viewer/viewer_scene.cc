@@ -1,0 +1,196 @@
+#include "viewer/viewer_scene.h"
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/sparse_model.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+size_t PlyTypeSize(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "double" || type == "float64") return 8;
+  return 4;  // int, uint, float and their sized names.
+}
+
+// Mean "up" (-y) of the source cameras in world coordinates; nullopt without cameras or when
+// they disagree so much that the mean is meaningless.
+std::optional<Eigen::Vector3d> CamerasUp(const std::vector<SourceView>& sources) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const SourceView& source : sources) {
+    sum += source.cam_from_world.rotation.conjugate() * Eigen::Vector3d(0, -1, 0);
+  }
+  if (sources.empty() || sum.norm() < 0.3 * static_cast<double>(sources.size())) {
+    return std::nullopt;
+  }
+  return sum.normalized();
+}
+
+// Points spread over the mesh by area (deterministic), so a large ground made of two
+// triangles weighs as much as it covers.
+std::vector<Eigen::Vector3f> SampleMesh(const TexturedMesh& mesh, int count) {
+  std::vector<double> cumulative;
+  double total = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3f& a = mesh.vertices[t[0]];
+    total += 0.5 * static_cast<double>((mesh.vertices[t[1]] - a).cross(mesh.vertices[t[2]] - a).norm());
+    cumulative.push_back(total);
+  }
+  std::vector<Eigen::Vector3f> samples;
+  if (!(total > 0)) return samples;
+  std::mt19937 random(1);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  for (int i = 0; i < count; ++i) {
+    const size_t index = static_cast<size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), uniform(random) * total) -
+        cumulative.begin());
+    const Eigen::Vector3i& t = mesh.triangles[std::min(index, mesh.triangles.size() - 1)];
+    double u = uniform(random), v = uniform(random);
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    samples.push_back(mesh.vertices[t[0]] +
+                      static_cast<float>(u) * (mesh.vertices[t[1]] - mesh.vertices[t[0]]) +
+                      static_cast<float>(v) * (mesh.vertices[t[2]] - mesh.vertices[t[0]]));
+  }
+  return samples;
+}
+
+// Bounds of the samples off the ground plus their footprints on it; empty when (nearly)
+// everything is ground.
+Eigen::AlignedBox3f FocusBounds(const std::vector<Eigen::Vector3f>& samples,
+                                const std::optional<GroundPlane>& ground, float tolerance) {
+  Eigen::AlignedBox3f focus;
+  if (!ground) return focus;
+  size_t count = 0;
+  for (const Eigen::Vector3f& p : samples) {
+    const double height = ground->SignedDistance(p.cast<double>());
+    if (std::abs(height) <= static_cast<double>(tolerance)) continue;
+    ++count;
+    focus.extend(p);
+    focus.extend((p.cast<double>() - height * ground->normal).cast<float>());
+  }
+  if (count < 10) focus.setEmpty();  // Too little off the ground to frame.
+  return focus;
+}
+
+std::vector<SourceView> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir) {
+  std::vector<SourceView> sources;
+  const SparseModel model = ReadSparseModel(sparse_dir);
+  for (const SparseImage& image : model.Images()) {
+    const Camera& camera = model.CameraById(image.camera_id);
+    if (!IsProjectionSupported(camera.model)) continue;
+    sources.push_back({image.name, camera, image.cam_from_world, images_dir / image.name});
+  }
+  return sources;
+}
+
+}  // namespace
+
+std::vector<ColouredPoint> ReadColouredPly(const fs::path& path) {
+  const std::string bytes = ReadFileBytes(path);
+  const size_t end = bytes.find("end_header\n");
+  if (!bytes.starts_with("ply\n") || end == std::string::npos) {
+    throw BadInputError(path.string() + ": not a PLY file");
+  }
+  std::istringstream lines(bytes.substr(0, end));
+  size_t count = 0, stride = 0;
+  bool in_vertex = false, little_endian = false;
+  std::map<std::string, size_t> offsets;  // Vertex property -> byte offset in a record.
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string keyword, type, name;
+    words >> keyword;
+    if (keyword == "format") {
+      words >> type;
+      little_endian = type == "binary_little_endian";
+    } else if (keyword == "element") {
+      if (in_vertex) break;  // The vertex element is the first one in every file we read.
+      words >> name >> count;
+      in_vertex = name == "vertex";
+    } else if (keyword == "property" && in_vertex) {
+      words >> type >> name;
+      if (type == "list") throw BadInputError(path.string() + ": list property in vertices");
+      offsets[name] = stride;
+      stride += PlyTypeSize(type);
+    }
+  }
+  if (!little_endian || !offsets.contains("x") || offsets.at("x") != 0 || !offsets.contains("z")) {
+    throw BadInputError(path.string() +
+                        ": expected binary_little_endian vertices starting with float x y z");
+  }
+  const size_t body = end + std::strlen("end_header\n");
+  if (stride == 0 || (bytes.size() - body) / stride < count) {
+    throw BadInputError(path.string() + ": " + std::to_string(count) +
+                        " vertices announced, the file is shorter");
+  }
+  const bool has_normal = offsets.contains("nx"), has_colour = offsets.contains("red");
+  std::vector<ColouredPoint> points(count);
+  for (size_t i = 0; i < count; ++i) {
+    const char* record = bytes.data() + body + i * stride;
+    ColouredPoint& point = points[i];
+    std::memcpy(point.position.data(), record, 12);
+    point.normal.setZero();
+    if (has_normal) std::memcpy(point.normal.data(), record + offsets.at("nx"), 12);
+    point.colour = {180, 180, 180};
+    if (has_colour) std::memcpy(point.colour.data(), record + offsets.at("red"), 3);
+    if (!point.position.allFinite() || !point.normal.allFinite()) {
+      throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
+    }
+  }
+  return points;
+}
+
+void FinishViewerScene(ViewerScene& scene) {
+  scene.bounds.setEmpty();
+  for (const Eigen::Vector3f& v : scene.mesh.vertices) scene.bounds.extend(v);
+  for (const ColouredPoint& p : scene.points) scene.bounds.extend(p.position);
+  if (scene.mesh.triangles.empty() && scene.points.empty()) {
+    throw BadInputError("the scene has neither a mesh nor a point cloud");
+  }
+  std::vector<Eigen::Vector3f> samples;
+  if (!scene.points.empty()) {
+    for (const ColouredPoint& p : scene.points) samples.push_back(p.position);
+  } else {
+    samples = SampleMesh(scene.mesh, 20000);
+  }
+  const std::optional<Eigen::Vector3d> cameras_up = CamerasUp(scene.sources);
+  const GroundPlaneOptions options;
+  scene.ground = FitGroundPlane(samples, cameras_up, options);
+  scene.up = scene.ground ? scene.ground->normal : cameras_up.value_or(Eigen::Vector3d::UnitZ());
+  // Mesh vertices too: area-weighted samples of a scene with a vast ground miss small objects.
+  samples.insert(samples.end(), scene.mesh.vertices.begin(), scene.mesh.vertices.end());
+  scene.focus = FocusBounds(samples, scene.ground, static_cast<float>(options.inlier_fraction_of_size) * scene.Radius() * 2);
+  if (scene.focus.isEmpty()) scene.focus = scene.bounds;
+}
+
+ViewerScene LoadViewerScene(const fs::path& workspace) {
+  if (!fs::is_directory(workspace)) {
+    throw BadInputError(workspace.string() + ": not a folder (expected a parallax workspace)");
+  }
+  ViewerScene scene;
+  const fs::path obj = workspace / "mesh" / "mesh.obj";
+  const fs::path ply = workspace / "fused.ply";
+  if (fs::exists(obj)) scene.mesh = ReadTexturedMesh(obj);
+  if (fs::exists(ply)) scene.points = ReadColouredPly(ply);
+  if (scene.mesh.triangles.empty() && scene.points.empty()) {
+    throw BadInputError(workspace.string() +
+                        ": nothing to show: no mesh/mesh.obj and no fused.ply in this folder "
+                        "(run 'parallax reconstruct' first)");
+  }
+  if (DetectSparseFormat(workspace / "sparse")) {
+    scene.sources = ReadSources(workspace / "sparse", workspace / "images");
+  } else if (DetectSparseFormat(workspace / "gt" / "sparse")) {
+    scene.sources = ReadSources(workspace / "gt" / "sparse", workspace / "images");
+  }
+  FinishViewerScene(scene);
+  return scene;
+}
+
+}  // namespace parallax

@@ -1,0 +1,33 @@
+#pragma once
+// The interactive viewer: a GLFW window drawing through the same Renderer as the offscreen
+// path, with a trackball (orbit, pan, zoom) and keys for every setting. Key help goes to
+// `log` (the terminal); the mode and the frame time go to the window title.
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "viewer/renderer.h"
+#include "viewer/viewer_scene.h"
+
+namespace parallax {
+
+struct WindowOptions {
+  int width = 1280;        // Initial window size in screen pixels.
+  int height = 720;
+  double fov_deg = 50;     // Horizontal field of view of the orbit camera.
+  double azimuth_deg = 30; // Initial orbit.
+  double elevation_deg = 25;
+  void Check() const;      // Throws std::invalid_argument naming the field.
+};
+
+// Runs until the window is closed or Esc is pressed. `start_source` jumps to that source
+// camera first (index into scene.sources). Throws ToolError when there is no display (the
+// message suggests --screenshot) or GLFW cannot open an OpenGL 3.3 core window.
+void RunViewerWindow(const ViewerScene& scene, RenderSettings settings, const WindowOptions& options,
+                     std::optional<int> start_source,
+                     const std::function<void(const std::string&)>& log);
+
+// The key help printed when the window opens.
+std::string ViewerKeyHelp();
+
+}  // namespace parallax
