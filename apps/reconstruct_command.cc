@@ -4,26 +4,12 @@
 #include <sstream>
 
 #include "apps/commands.h"
+#include "apps/number_list.h"
 #include "apps/terminal_progress.h"
 #include "pipeline/reconstruct.h"
 
 namespace parallax {
 namespace {
-
-std::vector<double> ParseIntrinsics(const std::string& text) {
-  std::vector<double> values;
-  std::stringstream stream(text);
-  for (std::string item; std::getline(stream, item, ',');) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw std::invalid_argument("--intrinsics '" + text + "': '" + item + "' is not a number");
-    }
-  }
-  return values;
-}
 
 void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path& workspace,
                   bool dry_run) {
@@ -121,7 +107,7 @@ void RegisterReconstructCommand(CLI::App& app) {
     options.camera_model = CameraModelFromName(arguments->camera_model);
     options.estimate_depth = !arguments->no_depth;
     options.build_mesh = !arguments->no_depth && !arguments->no_mesh;
-    if (!arguments->intrinsics.empty()) options.intrinsics = ParseIntrinsics(arguments->intrinsics);
+    if (!arguments->intrinsics.empty()) options.intrinsics = ParseNumberList(arguments->intrinsics, "--intrinsics");
     ReconstructSummary summary;
     {
       TerminalProgress progress;

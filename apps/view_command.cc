@@ -9,6 +9,7 @@
 #include <string>
 
 #include "apps/commands.h"
+#include "apps/number_list.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "viewer/egl_context.h"
@@ -39,19 +40,10 @@ struct ViewArguments {
 };
 
 std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
-  std::vector<double> values;
-  std::stringstream stream(text);
-  for (std::string item; std::getline(stream, item, ',');) {
-    try {
-      size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw std::invalid_argument(option + " " + text + ": '" + item + "' is not a number");
-    }
-  }
+  std::vector<double> values = ParseNumberList(text, option);
   if (values.size() != count) {
-    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) + " comma-separated numbers");
+    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) +
+                                " comma-separated numbers");
   }
   return values;
 }
