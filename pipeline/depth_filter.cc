@@ -20,6 +20,57 @@ void GeometricFilterOptions::Check() const {
   if (!(max_relative_depth > 0)) throw std::invalid_argument("max_relative_depth must be > 0");
   if (min_consistent_views < 1) throw std::invalid_argument("min_consistent_views must be >= 1");
   if (!(min_parallax_px > 0)) throw std::invalid_argument("min_parallax_px must be > 0");
+  if (fill_gaps_px < 0) throw std::invalid_argument("fill_gaps_px must be >= 0");
+  if (!(gap_max_relative_depth > 0)) throw std::invalid_argument("gap_max_relative_depth must be > 0");
+}
+
+namespace {
+
+// The nearest kept depth from (x, y) along (dx, dy), within `reach` pixels.
+struct Neighbour {
+  float depth = 0;
+  float confidence = 0;
+  int distance = 0;
+};
+Neighbour Nearest(const FilteredDepth& map, int x, int y, int dx, int dy, int reach) {
+  for (int step = 1; step <= reach; ++step) {
+    const int nx = x + step * dx, ny = y + step * dy;
+    if (nx < 0 || ny < 0 || nx >= map.depth.Width() || ny >= map.depth.Height()) break;
+    if (map.depth.At(nx, ny) > 0) return {map.depth.At(nx, ny), map.confidence.At(nx, ny), step};
+  }
+  return {};
+}
+
+}  // namespace
+
+void FillGaps(int max_gap_px, double max_relative_depth, FilteredDepth& map) {
+  const FilteredDepth kept = map;  // Fill from kept depths only, never from filled ones.
+  const int width = map.depth.Width(), height = map.depth.Height();
+  constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+  tbb::parallel_for(0, height, [&](int y) {
+    for (int x = 0; x < width; ++x) {
+      if (kept.depth.At(x, y) > 0) continue;
+      double inverse_sum = 0, weight_sum = 0;
+      float confidence = 1;
+      int enclosing_axes = 0;
+      for (const auto& axis : kAxes) {
+        const Neighbour a = Nearest(kept, x, y, axis[0], axis[1], max_gap_px);
+        const Neighbour b = Nearest(kept, x, y, -axis[0], -axis[1], max_gap_px);
+        if (a.distance == 0 || b.distance == 0) continue;
+        const float low = std::min(a.depth, b.depth), high = std::max(a.depth, b.depth);
+        if (static_cast<double>(high - low) > max_relative_depth * static_cast<double>(low)) continue;
+        ++enclosing_axes;
+        for (const Neighbour& n : {a, b}) {
+          inverse_sum += 1.0 / (static_cast<double>(n.depth) * n.distance);
+          weight_sum += 1.0 / n.distance;
+          confidence = std::min(confidence, n.confidence);
+        }
+      }
+      if (enclosing_axes < 2) continue;
+      map.depth.At(x, y) = static_cast<float>(weight_sum / inverse_sum);
+      map.confidence.At(x, y) = 0.5f * confidence;
+    }
+  });
 }
 
 FilteredDepth FilterGeometric(
@@ -79,6 +130,7 @@ FilteredDepth FilterGeometric(
       }
     }
   });
+  if (options.fill_gaps_px > 0) FillGaps(options.fill_gaps_px, options.gap_max_relative_depth, result);
   return result;
 }
 

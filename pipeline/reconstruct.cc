@@ -76,7 +76,7 @@ uint64_t HashFolder(const fs::path& dir) {
 }
 
 // Bump when the depth stage's results change for the same options, so caches recompute.
-constexpr const char* kMvsVersion = "patch-match-5";
+constexpr const char* kMvsVersion = "patch-match-6";
 constexpr const char* kFusionVersion = "fusion-1";
 constexpr const char* kMeshVersion = "mesh-1";
 

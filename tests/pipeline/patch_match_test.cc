@@ -148,10 +148,12 @@ TEST(PatchMatch, StepEdgeIsNotBlurredIntoIntermediateDepths) {
   const Accuracy photometric = Measure(EstimateDepth(rig, 1, 50).depth, rig.truth[0]);
   EXPECT_GT(photometric.coverage, 0.8);
   EXPECT_GT(photometric.within_1pct, 0.8);
-  // ... and the geometric filter (2% agreement) removes the fringe.
+  // ... and the geometric filter (3% agreement) removes most of the fringe (measured: 96.5% of
+  // the kept depths within 2%; 97.5% with a 2% agreement, which costs 1.1 points of
+  // completeness on the courtyard).
   const Accuracy filtered = Measure(EstimateAndFilter(rig, 1, 50).depth, rig.truth[0]);
   EXPECT_GT(filtered.coverage, 0.7);
-  EXPECT_GT(filtered.within_2pct, 0.97);
+  EXPECT_GT(filtered.within_2pct, 0.96);
 }
 
 TEST(PatchMatch, TexturelessSurfacesGetNoDepth) {
@@ -203,9 +205,9 @@ TEST(PatchMatch, GeometricFilterKeepsConsistentDepthsWithConfidence) {
   for (size_t i = 1; i < rig.views.size(); ++i) sources.emplace_back(&rig.views[i], &truths[i]);
   const FilteredDepth filtered = FilterGeometric(rig.views[0], truths[0], sources, {});
   EXPECT_GT(Measure(filtered.depth, rig.truth[0]).coverage, 0.9);
-  // A depth 3% off is inconsistent with every source (the filter allows 2%) and removed.
+  // A depth 5% off is inconsistent with every source (the filter allows 3%) and removed.
   DepthNormalMap wrong = truths[0];
-  for (float& value : wrong.depth.Values()) value *= 1.03f;
+  for (float& value : wrong.depth.Values()) value *= 1.05f;
   EXPECT_LT(Measure(FilterGeometric(rig.views[0], wrong, sources, {}).depth, rig.truth[0]).coverage, 0.01);
 }
 
@@ -250,6 +252,41 @@ TEST(PatchMatch, WindowCostIsZeroForIdenticalAndAffineRelitWindows) {
   EXPECT_FLOAT_EQ(WindowCost(image, 20, 20, image, shifted, options), 2.0f);
   const GrayImage flat{40, 40, std::vector<float>(1600, 0.5f)};
   EXPECT_FLOAT_EQ(WindowCost(flat, 20, 20, flat, Eigen::Matrix3d::Identity(), options), 2.0f);
+}
+
+}  // namespace
+}  // namespace parallax
+
+namespace parallax {
+namespace {
+
+TEST(DepthFilter, GapsInsideASurfaceAreFilledButDepthEdgesAreNotBridged) {
+  FilteredDepth map{DepthMap(20, 10), DepthMap(20, 10)};
+  // Left half at depth 2 + x/100 (a slanted plane), right half a wall at 4.
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 20; ++x) {
+      map.depth.At(x, y) = x < 10 ? 2.0f + 0.01f * static_cast<float>(x) : 4.0f;
+      map.confidence.At(x, y) = 0.8f;
+    }
+  }
+  // A 3x3 gap inside the plane, and a 2-px wide gap along the edge between the halves.
+  for (int y = 3; y < 6; ++y) {
+    for (int x = 3; x < 6; ++x) map.depth.At(x, y) = map.confidence.At(x, y) = 0;
+  }
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 9; x < 11; ++x) map.depth.At(x, y) = map.confidence.At(x, y) = 0;
+  }
+  FillGaps(4, 0.02, map);
+  for (int y = 3; y < 6; ++y) {
+    for (int x = 3; x < 6; ++x) {
+      EXPECT_NEAR(map.depth.At(x, y), 2.0f + 0.01f * static_cast<float>(x), 1e-3f) << x << "," << y;
+      EXPECT_FLOAT_EQ(map.confidence.At(x, y), 0.4f);
+    }
+  }
+  for (int y = 0; y < 10; ++y) {
+    EXPECT_EQ(map.depth.At(9, y), 0.0f) << "the step from 2.08 to 4 is an edge, not a gap";
+    EXPECT_EQ(map.depth.At(10, y), 0.0f);
+  }
 }
 
 }  // namespace
