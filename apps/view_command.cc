@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -7,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
@@ -27,7 +29,7 @@ struct ViewArguments {
   std::filesystem::path screenshot;
   std::string camera;
   std::optional<double> orbit_deg;
-  double elevation_deg = 30;
+  std::optional<double> elevation_deg;  // Default: the source cameras' elevation, else 30.
   double fov_deg = 50;
   std::string size;  // "WxH"
   std::string light = "45,50";  // Azimuth, elevation (degrees) of a directional light.
@@ -37,6 +39,7 @@ struct ViewArguments {
   RenderSettings settings;
   bool no_cameras = false;
   bool no_grid = false;
+  int timed_frames = 0;  // Extra frames drawn after the screenshot to time the renderer.
 };
 
 std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
@@ -89,6 +92,21 @@ std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name
   return std::nullopt;
 }
 
+// Draws `frames` more frames of the same view, each finished with glFinish, and prints the
+// median and the fastest: the frame time of the interactive viewer holding still.
+void PrintFrameTimes(Renderer& renderer, const ViewCamera& view, const RenderSettings& settings, int frames) {
+  std::vector<double> ms;
+  for (int i = 0; i < frames; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    renderer.Draw(view, settings);
+    renderer.Finish();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  std::printf("frame time over %d frames (%dx%d): median %.1f ms, min %.1f ms\n", frames,
+              static_cast<int>(view.camera.width), static_cast<int>(view.camera.height), ms[ms.size() / 2], ms[0]);
+}
+
 void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const RenderSettings& settings) {
   const std::optional<std::pair<int, int>> size =
       a.size.empty() ? std::nullopt : std::optional(ParseSize(a.size));
@@ -109,6 +127,7 @@ void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const Rend
   WriteImage(a.screenshot, result.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
   std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), result.colour.Width(),
               result.colour.Height(), ms);
+  if (a.timed_frames > 0) PrintFrameTimes(renderer, view, settings, a.timed_frames);
 }
 
 }  // namespace
@@ -123,9 +142,12 @@ void RegisterViewCommand(CLI::App& app) {
       ->required();
   command->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
   auto* camera = command->add_option("--camera", a->camera, "view from this source camera (image name or stem)");
-  command->add_option("--orbit", a->orbit_deg, "view from an orbit about the scene centre at this azimuth (degrees)")
+  command->add_option("--orbit", a->orbit_deg, "view from an orbit about the scene at this azimuth (degrees); it looks where the source cameras look, "
+                 "from as far, when they surround the scene")
       ->excludes(camera);
-  command->add_option("--elevation", a->elevation_deg, "orbit elevation above the ground (degrees, default 30)");
+  command->add_option("--elevation", a->elevation_deg,
+                      "orbit elevation above the ground (degrees; default: the source cameras' when they "
+                      "surround the scene, else 30)");
   command->add_option("--fov", a->fov_deg, "orbit camera's horizontal field of view (degrees, default 50)")
       ->check(CLI::Range(1.0, 170.0));
   command->add_option("--size", a->size, "image size WxH (default 1280x720; a source camera's own size)");
@@ -147,6 +169,9 @@ void RegisterViewCommand(CLI::App& app) {
       ->check(CLI::Range(64, 8192));
   command->add_option("--pcf-radius", a->settings.pcf_radius, "PCF kernel radius in texels (default 1)")
       ->check(CLI::Range(0, 4));
+  command->add_option("--time-frames", a->timed_frames,
+                      "with --screenshot: draw this many more frames and print the median frame time")
+      ->check(CLI::Range(1, 10000));
   command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {

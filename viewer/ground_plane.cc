@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 #include <ceres/ceres.h>
 
+#include "viewer/robust_bounds.h"
+
 namespace parallax {
 namespace {
 
@@ -128,9 +130,9 @@ std::optional<GroundPlane> FitGroundPlane(const std::vector<Eigen::Vector3f>& po
   options.Check();
   constexpr size_t kMinPoints = 30;
   if (points.size() < kMinPoints) return std::nullopt;
-  Eigen::AlignedBox3d box;
-  for (const Eigen::Vector3f& p : points) box.extend(p.cast<double>());
-  const double threshold = options.inlier_fraction_of_size * box.diagonal().norm();
+  // Robust bounds: a few far outliers of a fused cloud must not loosen the threshold.
+  const Eigen::AlignedBox3f box = RobustBounds(points);
+  const double threshold = options.inlier_fraction_of_size * static_cast<double>(box.diagonal().norm());
   if (!(threshold > 0)) return std::nullopt;  // All points coincide.
 
   Plane plane = Ransac(points, up_hint, threshold, options);

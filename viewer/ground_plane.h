@@ -18,7 +18,7 @@ struct GroundPlane {
 };
 
 struct GroundPlaneOptions {
-  // Inlier distance, as a fraction of the points' bounding-box diagonal.
+  // Inlier distance, as a fraction of the diagonal of the points' robust bounds (RobustBounds).
   double inlier_fraction_of_size = 0.005;
   // A plane needs at least this share of the points (and 30 points) to count as the ground.
   double min_inlier_ratio = 0.15;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <tuple>
@@ -121,7 +122,8 @@ void AddLine(std::vector<Vertex>& lines, const Eigen::Vector3d& a, const Eigen::
 }
 
 // Each source camera as a pyramid from its centre to its image corners at `depth`, with a
-// tick on the top edge so "up" is visible.
+// tick on the top edge so "up" is visible: kFrustumVertices line vertices per camera, in order.
+constexpr int kFrustumVertices = 18;
 std::vector<Vertex> FrustumLines(const std::vector<SourceView>& sources, double depth) {
   std::vector<Vertex> lines;
   const Eigen::Vector3f colour(0.9f, 0.45f, 0.1f);
@@ -146,34 +148,73 @@ std::vector<Vertex> FrustumLines(const std::vector<SourceView>& sources, double 
   return lines;
 }
 
-// A square grid on the ground (or, without one, under the scene, normal to `up`).
+// How deep the frusta are drawn: 4% of the scene's robust size, but no more than the median
+// spacing of neighbouring cameras, so a dense rig does not turn into a tangle of lines.
+double FrustumDepth(const ViewerScene& scene) {
+  const double size = static_cast<double>(scene.extent.diagonal().norm());
+  double depth = 0.04 * size;
+  const size_t n = scene.sources.size();
+  if (n < 2 || n > 2000) return depth;  // Quadratic below; 2000 cameras take a few ms.
+  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; ++j) {
+      const double d = (CameraCenter(scene.sources[i].cam_from_world) - CameraCenter(scene.sources[j].cam_from_world)).norm();
+      nearest[i] = std::min(nearest[i], d);
+      nearest[j] = std::min(nearest[j], d);
+    }
+  }
+  std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(n / 2), nearest.end());
+  return std::clamp(nearest[n / 2], 0.005 * size, depth);
+}
+
+// A round grid step: 1, 2 or 5 times a power of ten, at least `minimum`.
+double NiceStep(double minimum) {
+  const double power = std::pow(10.0, std::floor(std::log10(minimum)));
+  for (double factor : {1.0, 2.0, 5.0, 10.0}) {
+    if (factor * power >= minimum) return factor * power;
+  }
+  return 10 * power;
+}
+
+// A square grid with round steps on the ground (or, without one, under the scene, normal to
+// `up`), covering the footprint of the robust extent: outliers do not stretch it.
 std::vector<Vertex> GridLines(const ViewerScene& scene) {
   const Eigen::Vector3d up = scene.up;
   const Eigen::Vector3d centre = scene.Centre().cast<double>();
-  double height = 0;  // Of the grid plane along `up`, relative to the scene centre.
+  double height = 0;  // Of the grid plane along `up`, relative to the extent's centre.
   if (scene.ground) {
     height = -scene.ground->SignedDistance(centre);
   } else {
     height = std::numeric_limits<double>::infinity();
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d corner =
-          scene.bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>();
+          scene.extent.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>();
       height = std::min(height, up.dot(corner - centre));
     }
   }
-  // Just under the ground, so the ground mesh hides the grid instead of z-fighting with it.
-  const Eigen::Vector3d origin = centre + (height - 1e-3 * static_cast<double>(scene.Radius())) * up;
   const Eigen::Vector3d reference = std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d u = (reference - up * up.dot(reference)).normalized();
   const Eigen::Vector3d v = up.cross(u);
-  const double half = 1.5 * static_cast<double>(scene.Radius());
-  constexpr int kLines = 20;
+  double half = 1e-6 * std::max(1.0, static_cast<double>(scene.Radius()));
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d offset = scene.extent.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>() - centre;
+    half = std::max({half, std::abs(u.dot(offset)), std::abs(v.dot(offset))});
+  }
+  constexpr int kMinCells = 16;  // Across the footprint.
+  const double step = NiceStep(2 * half / kMinCells);
+  const int cells = static_cast<int>(std::ceil(half / step - 1e-9));
+  // Just under the ground, so the ground mesh hides the grid instead of z-fighting with it;
+  // centred on a multiple of the step, so lines fall on round coordinates.
+  Eigen::Vector3d origin = centre + (height - 1e-3 * static_cast<double>(scene.Radius())) * up;
+  origin += (std::round(u.dot(origin) / step) * step - u.dot(origin)) * u +
+            (std::round(v.dot(origin) / step) * step - v.dot(origin)) * v;
+  const double extent = (cells + 1) * step;
   std::vector<Vertex> lines;
   const Eigen::Vector3f colour(0.55f, 0.55f, 0.55f);
-  for (int i = 0; i <= kLines; ++i) {
-    const double s = -half + 2 * half * i / kLines;
-    AddLine(lines, origin + s * u - half * v, origin + s * u + half * v, colour);
-    AddLine(lines, origin - half * u + s * v, origin + half * u + s * v, colour);
+  for (int i = -cells - 1; i <= cells + 1; ++i) {
+    const double s = i * step;
+    AddLine(lines, origin + s * u - extent * v, origin + s * u + extent * v, colour);
+    AddLine(lines, origin - extent * u + s * v, origin + extent * u + s * v, colour);
   }
   return lines;
 }
@@ -304,6 +345,17 @@ std::vector<int> NearestSourceViews(const ViewerScene& scene, const Eigen::Vecto
   return nearest;
 }
 
+// What the shadow map was rendered with; the same key, the same map.
+struct ShadowMapKey {
+  Eigen::Matrix4f light_clip_from_world;
+  int size = 0;
+  float slope_bias = 0;
+  bool operator==(const ShadowMapKey& other) const {
+    return light_clip_from_world == other.light_clip_from_world && size == other.size &&
+           slope_bias == other.slope_bias;
+  }
+};
+
 struct Renderer::Impl {
   const ViewerScene& scene;
   bool reverse_z = false;  // glClipControl is available (and then always set to zero-to-one).
@@ -316,8 +368,11 @@ struct Renderer::Impl {
   Eigen::Vector4f ground_plane = Eigen::Vector4f::Zero();
   float ground_tolerance = 0;
   Drawable mesh, points, frusta, grid;
+  double frustum_depth = 0;  // Scene units.
+  std::vector<Eigen::Vector3d> source_centres;
   GlTexture atlas;
   DepthTarget shadow;
+  std::optional<ShadowMapKey> shadow_key;  // Absent until the map holds a rendering.
   DepthTarget projector_depth[kMaxProjectors];
   std::map<int, GlTexture> photos;  // By source index, loaded on first use.
   EyeTarget eye;
@@ -335,8 +390,11 @@ struct Renderer::Impl {
     return {towards.x(), towards.y(), towards.z(), 0};
   }
   Eigen::Matrix4f LightMatrix(const LightSettings& light) const {
-    return light.type == LightKind::kPoint ? PointLightMatrix(light.position, scene.bounds, Range())
-                                           : DirectionalLightMatrix(light.direction, scene.bounds, Range());
+    // The map covers the robust extent (its resolution is not spent on outliers); its depth
+    // range holds everything, so no caster is clipped away.
+    return light.type == LightKind::kPoint
+               ? PointLightMatrix(light.position, scene.extent, scene.bounds, Range())
+               : DirectionalLightMatrix(light.direction, scene.extent, scene.bounds, Range());
   }
   // What casts shadows and occludes projectors: the mesh when there is one, else the points.
   void DrawCasters(const RenderSettings& settings, const GlProgram& program) {
@@ -348,6 +406,19 @@ struct Renderer::Impl {
       glBindVertexArray(points.vao.Get());
       glDrawArrays(GL_POINTS, 0, points.count);
     }
+  }
+  // The frusta, but those of cameras within three frustum depths of the eye: the one looked
+  // through, or one just in front of the eye, would cross the whole image.
+  void DrawFrusta(const Eigen::Vector3d& eye_centre) {
+    glBindVertexArray(frusta.vao.Get());
+    GLint first = 0;
+    for (size_t i = 0; i < source_centres.size(); ++i) {
+      if ((source_centres[i] - eye_centre).norm() >= 3 * frustum_depth) continue;
+      const GLint skipped = static_cast<GLint>(i) * kFrustumVertices;
+      if (skipped > first) glDrawArrays(GL_LINES, first, skipped - first);
+      first = skipped + kFrustumVertices;
+    }
+    if (frusta.count > first) glDrawArrays(GL_LINES, first, frusta.count - first);
   }
   void RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
                       const RenderSettings& settings, float slope_bias);
@@ -528,7 +599,9 @@ Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scen
   r.lines = GlProgram("lines", shaders::kLineVertex, shaders::kLineFragment);
   if (!scene.mesh.triangles.empty()) r.mesh = Upload(MeshVertices(scene.mesh, scene.ground));
   if (!scene.points.empty()) r.points = Upload(PointVertices(scene.points));
-  if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, 0.12 * static_cast<double>(scene.FocusRadius())));
+  r.frustum_depth = FrustumDepth(scene);
+  for (const SourceView& source : scene.sources) r.source_centres.push_back(CameraCenter(source.cam_from_world));
+  if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, r.frustum_depth));
   r.grid = Upload(GridLines(scene));
   if (!scene.mesh.atlas.Empty()) r.atlas = UploadSrgbTexture(scene.mesh.atlas);
 
@@ -541,6 +614,8 @@ Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scen
 }
 
 Renderer::~Renderer() = default;
+
+void Renderer::Finish() const { glFinish(); }
 
 bool Renderer::UsesReverseZ() const { return impl_->reverse_z; }
 
@@ -556,10 +631,14 @@ void Renderer::Draw(const ViewCamera& view, const RenderSettings& settings, int 
   int shadow_mode_uniform = 0;
   if (settings.shadows == ShadowMode::kMap || settings.shadows == ShadowMode::kPcf) {
     const Eigen::Matrix4f light_matrix = r.LightMatrix(settings.light);
-    r.shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
     // PCF taps up to r texels away compare against the centre's depth: more slope bias.
-    const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + settings.pcf_radius : 1.5f;
-    r.RenderDepthMap(r.shadow, light_matrix, settings, slope_bias);
+    const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + static_cast<float>(settings.pcf_radius) : 1.5f;
+    const ShadowMapKey key{light_matrix, settings.shadow_map_size, slope_bias};
+    if (r.shadow_key != key) {
+      r.shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
+      r.RenderDepthMap(r.shadow, light_matrix, settings, slope_bias);
+      r.shadow_key = key;
+    }
     r.shadow_from_world = light_matrix;
     shadow_mode_uniform = settings.shadows == ShadowMode::kMap ? 2 : 3;
   }
@@ -620,10 +699,7 @@ void Renderer::Draw(const ViewCamera& view, const RenderSettings& settings, int 
     glBindVertexArray(r.grid.vao.Get());
     glDrawArrays(GL_LINES, 0, r.grid.count);
   }
-  if (settings.show_cameras && r.frusta.count > 0) {
-    glBindVertexArray(r.frusta.vao.Get());
-    glDrawArrays(GL_LINES, 0, r.frusta.count);
-  }
+  if (settings.show_cameras && r.frusta.count > 0) r.DrawFrusta(CameraCenter(view.cam_from_world));
   glBindVertexArray(0);
   if (!reverse_z && r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
 

@@ -24,7 +24,7 @@ enum class ShadowMode {
   kNone,
   kPlanar,  // Geometry flattened onto the fitted ground along the light, stencil-masked.
   kMap,     // Shadow map, hardware depth comparison (bilinear between 4 texels).
-  kPcf,     // Shadow map filtered over a (2r+1)^2 kernel.
+  kPcf,     // Shadow map filtered over (2r+1)^2 texels (tent weights, (2r)^2 bilinear taps).
 };
 
 enum class TextureMode {
@@ -88,11 +88,16 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   // Draws one frame of the view's camera size into the internal framebuffer and, when
-  // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer).
+  // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer). The
+  // shadow map is re-rendered only when the light, its size or the PCF bias changed (the scene
+  // is fixed): moving the eye costs the main pass alone.
   void Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer = -1);
 
   // Draws and reads the frame back.
   RenderResult Render(const ViewCamera& view, const RenderSettings& settings);
+
+  // Waits until every GL command issued so far has finished (glFinish), e.g. to time a frame.
+  void Finish() const;
 
   bool UsesReverseZ() const;
   // Messages for the user, e.g. that planar shadows are skipped without a ground plane.

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 
 #include "core/error.h"
 #include "viewer/view_math.h"
@@ -26,16 +25,39 @@ ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
                       (known.empty() ? " (the workspace has no sparse model)" : " (there are: " + known + ")"));
 }
 
-ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, double elevation_deg,
+Orbit DefaultOrbit(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
+                   const Camera& camera) {
+  if (scene.rig) {
+    // As far as the photos' width of the scene needs with this camera's field of view.
+    const double view_tan = 0.5 * static_cast<double>(camera.width) / camera.FocalX();
+    const double scale = std::clamp(scene.rig->half_width_tan / view_tan, 0.25, 4.0);
+    return Orbit{scene.rig->target, scale * scene.rig->distance, elevation_deg.value_or(scene.rig->elevation_deg)};
+  }
+  Orbit orbit{scene.FocusCentre().cast<double>(), 1, elevation_deg.value_or(30)};
+  // The camera's rotation does not depend on the distance d: a corner at q = R (p - target)
+  // seen from distance d has depth q.z + d and must satisfy f |q.x| / (q.z + d) <= kFill W / 2
+  // (and likewise in y).
+  constexpr double kFill = 0.8;
+  const Eigen::Quaterniond rotation = OrbitPose(orbit.target, scene.up, azimuth_deg, orbit.elevation_deg, 1).rotation;
+  const double half_w = 0.5 * kFill * static_cast<double>(camera.width);
+  const double half_h = 0.5 * kFill * static_cast<double>(camera.height);
+  const double size = std::max(1e-6, static_cast<double>(scene.focus.diagonal().norm()));
+  double distance = 1e-3 * size;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d q =
+        rotation * (scene.focus.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner)).cast<double>() - orbit.target);
+    distance = std::max({distance, camera.FocalX() * std::abs(q.x()) / half_w - q.z(),
+                         camera.FocalY() * std::abs(q.y()) / half_h - q.z(), 1e-3 * size - q.z()});
+  }
+  orbit.distance = distance;
+  return orbit;
+}
+
+ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
                            int width, int height, double fov_deg) {
   const Camera camera = ViewerCamera(width, height, fov_deg);
-  // The narrower of the two fields of view must hold the bounding sphere.
-  const double half_fov = std::atan(0.5 * std::min(width, height) / camera.FocalX());
-  const double distance = 1.05 * static_cast<double>(scene.FocusRadius()) / std::sin(half_fov);
-  return ViewCamera{camera,
-                    OrbitPose(scene.FocusCentre().cast<double>(), scene.up, azimuth_deg, elevation_deg,
-                              std::max(distance, 1e-6)),
-                    0};
+  const Orbit orbit = DefaultOrbit(scene, azimuth_deg, elevation_deg, camera);
+  return ViewCamera{camera, OrbitPose(orbit.target, scene.up, azimuth_deg, orbit.elevation_deg, orbit.distance), 0};
 }
 
 ViewCamera ScaledSourceViewCamera(const SourceView& source, int width, int height) {

@@ -96,18 +96,22 @@ Eigen::Vector2d DepthBounds(const Eigen::AlignedBox3f& box, const Rigid3d& cam_f
   return {near, far};
 }
 
-Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction,
-                                       const Eigen::AlignedBox3f& box, DepthRange range) {
+Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const Eigen::AlignedBox3f& box,
+                                       const Eigen::AlignedBox3f& depth_box, DepthRange range) {
   const Eigen::Vector3d centre = box.center().cast<double>();
   const double radius = std::max(1e-9, 0.5 * static_cast<double>(box.diagonal().norm()));
   const Rigid3d light_from_world = LookAlong(centre - 2 * radius * direction.normalized(), direction);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
   for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p =
-        light_from_world * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner)).cast<double>();
+    const auto type = static_cast<Eigen::AlignedBox3f::CornerType>(corner);
+    const Eigen::Vector3d p = light_from_world * box.corner(type).cast<double>();
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
+    if (depth_box.isEmpty()) continue;
+    const double z = (light_from_world * depth_box.corner(type).cast<double>()).z();
+    lo.z() = std::min(lo.z(), z);
+    hi.z() = std::max(hi.z(), z);
   }
   // A sliver of margin so the scene's extreme surfaces are not clipped by the depth range.
   const Eigen::Vector3d margin = 1e-3 * radius * Eigen::Vector3d::Ones();
@@ -115,7 +119,7 @@ Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction,
 }
 
 Eigen::Matrix4f PointLightMatrix(const Eigen::Vector3d& position, const Eigen::AlignedBox3f& box,
-                                 DepthRange range) {
+                                 const Eigen::AlignedBox3f& depth_box, DepthRange range) {
   const Eigen::Vector3d centre = box.center().cast<double>();
   const Eigen::Vector3d forward =
       (centre - position).norm() > 1e-9 ? Eigen::Vector3d(centre - position) : Eigen::Vector3d::UnitZ();
@@ -134,7 +138,7 @@ Eigen::Matrix4f PointLightMatrix(const Eigen::Vector3d& position, const Eigen::A
   }
   tan_half = std::clamp(tan_half * 1.01, 1e-3, std::tan(Radians(80)));
   const Camera square = MakePinholeCamera(1, 2, 2, 1 / tan_half, 1 / tan_half, 1, 1);
-  const Eigen::Vector2d depth = DepthBounds(box, light_from_world);
+  const Eigen::Vector2d depth = DepthBounds(depth_box.isEmpty() ? box : box.merged(depth_box), light_from_world);
   return PerspectiveProjection(square, depth[0], depth[1], range) * ViewMatrix(light_from_world);
 }
 

@@ -39,14 +39,17 @@ Eigen::Matrix4f OrthographicProjection(const Eigen::Vector3d& min, const Eigen::
 Eigen::Vector2d DepthBounds(const Eigen::AlignedBox3f& box, const Rigid3d& cam_from_world);
 
 // light_clip_from_world of a directional light travelling along `direction`: orthographic,
-// tightly bounding the box's eight corners in the light's frame.
-Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction,
-                                       const Eigen::AlignedBox3f& box, DepthRange range);
+// tightly bounding the box's eight corners across the light; along it, the depth range also
+// holds `depth_box` (e.g. the exact bounds, when `box` leaves out outliers: casters outside
+// `box` must not be clipped away from the map).
+Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const Eigen::AlignedBox3f& box,
+                                       const Eigen::AlignedBox3f& depth_box, DepthRange range);
 
 // light_clip_from_world of a point light at `position` looking at the box: a square
-// perspective frustum that contains the box's corners, near/far fitted to them.
+// perspective frustum that contains the box's corners, near/far fitted to the corners of the
+// box and of `depth_box`.
 Eigen::Matrix4f PointLightMatrix(const Eigen::Vector3d& position, const Eigen::AlignedBox3f& box,
-                                 DepthRange range);
+                                 const Eigen::AlignedBox3f& depth_box, DepthRange range);
 
 // Planar projection onto `plane` along the light: light is (towards-light direction, 0) for a
 // directional light or (position, 1) for a point light. M = (pi . l) I - l pi^T.

@@ -1,14 +1,19 @@
 #include "viewer/viewer_scene.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
+#include <numbers>
 #include <random>
 #include <sstream>
+
+#include <Eigen/Dense>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/sparse_model.h"
+#include "viewer/robust_bounds.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -62,22 +67,30 @@ std::vector<Eigen::Vector3f> SampleMesh(const TexturedMesh& mesh, int count) {
   return samples;
 }
 
-// Bounds of the samples off the ground plus their footprints on it; empty when (nearly)
-// everything is ground.
+// Robust bounds of the samples off the ground plus their footprints on it; empty when
+// (nearly) everything is ground.
 Eigen::AlignedBox3f FocusBounds(const std::vector<Eigen::Vector3f>& samples,
                                 const std::optional<GroundPlane>& ground, float tolerance) {
-  Eigen::AlignedBox3f focus;
-  if (!ground) return focus;
-  size_t count = 0;
+  if (!ground) return {};
+  std::vector<Eigen::Vector3f> standing;
   for (const Eigen::Vector3f& p : samples) {
     const double height = ground->SignedDistance(p.cast<double>());
     if (std::abs(height) <= static_cast<double>(tolerance)) continue;
-    ++count;
-    focus.extend(p);
-    focus.extend((p.cast<double>() - height * ground->normal).cast<float>());
+    standing.push_back(p);
+    standing.push_back((p.cast<double>() - height * ground->normal).cast<float>());
   }
-  if (count < 10) focus.setEmpty();  // Too little off the ground to frame.
-  return focus;
+  if (standing.size() < 20) return {};  // Too little off the ground to frame.
+  return RobustBounds(standing);
+}
+
+// Every k-th point, at most about `count` of them (deterministic): robust statistics and the
+// ground fit need no million points.
+std::vector<Eigen::Vector3f> Subsample(const std::vector<ColouredPoint>& points, size_t count) {
+  const size_t stride = std::max<size_t>(1, (points.size() + count - 1) / count);
+  std::vector<Eigen::Vector3f> positions;
+  positions.reserve(points.size() / stride + 1);
+  for (size_t i = 0; i < points.size(); i += stride) positions.push_back(points[i].position);
+  return positions;
 }
 
 std::vector<SourceView> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir) {
@@ -147,27 +160,77 @@ std::vector<ColouredPoint> ReadColouredPly(const fs::path& path) {
   return points;
 }
 
+std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, const Eigen::Vector3d& up,
+                                      const Eigen::AlignedBox3f& extent) {
+  constexpr size_t kMinCameras = 3;
+  if (sources.size() < kMinCameras || extent.isEmpty()) return std::nullopt;
+  // Least squares: the point whose summed squared distance to the optical axes is least,
+  // sum (I - d d^T) x = sum (I - d d^T) c.
+  Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (const SourceView& source : sources) {
+    const Eigen::Vector3d d = source.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+    const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - d * d.transpose();
+    a += across;
+    b += across * CameraCenter(source.cam_from_world);
+  }
+  // Parallel axes (a walk looking ahead) leave the point undetermined along them.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(a);
+  if (eigen.eigenvalues()[0] < 0.02 * static_cast<double>(sources.size())) return std::nullopt;
+  CameraRig rig;
+  rig.target = a.ldlt().solve(b);
+  const Eigen::Vector3f grow = Eigen::Vector3f::Constant(0.5f * extent.diagonal().norm());
+  const Eigen::AlignedBox3f near_extent(extent.min() - grow, extent.max() + grow);
+  if (!rig.target.allFinite() || !near_extent.contains(rig.target.cast<float>())) return std::nullopt;
+  std::vector<double> distances, elevations, half_width_tans;
+  size_t in_front = 0;
+  for (const SourceView& source : sources) {
+    in_front += (source.cam_from_world * rig.target).z() > 0;
+    const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - rig.target;
+    distances.push_back(offset.norm());
+    half_width_tans.push_back(0.5 * static_cast<double>(source.camera.width) / source.camera.FocalX());
+    elevations.push_back(std::asin(std::clamp(up.dot(offset) / std::max(offset.norm(), 1e-12), -1.0, 1.0)) * 180 /
+                         std::numbers::pi);
+  }
+  if (4 * in_front < 3 * sources.size()) return std::nullopt;
+  const auto median = [](std::vector<double>& values) {
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+    return values[values.size() / 2];
+  };
+  rig.distance = median(distances);
+  rig.elevation_deg = median(elevations);
+  rig.half_width_tan = median(half_width_tans);
+  if (!(rig.distance > 0)) return std::nullopt;
+  return rig;
+}
+
 void FinishViewerScene(ViewerScene& scene) {
-  scene.bounds.setEmpty();
-  for (const Eigen::Vector3f& v : scene.mesh.vertices) scene.bounds.extend(v);
-  for (const ColouredPoint& p : scene.points) scene.bounds.extend(p.position);
   if (scene.mesh.triangles.empty() && scene.points.empty()) {
     throw BadInputError("the scene has neither a mesh nor a point cloud");
   }
-  std::vector<Eigen::Vector3f> samples;
-  if (!scene.points.empty()) {
-    for (const ColouredPoint& p : scene.points) samples.push_back(p.position);
-  } else {
-    samples = SampleMesh(scene.mesh, 20000);
-  }
+  scene.bounds.setEmpty();
+  for (const Eigen::Vector3f& v : scene.mesh.vertices) scene.bounds.extend(v);
+  for (const ColouredPoint& p : scene.points) scene.bounds.extend(p.position);
+  // What is shown: the mesh, sampled by area so a large ground of two triangles weighs as much
+  // as it covers, else the cloud.
+  constexpr size_t kSamples = 200000;
+  std::vector<Eigen::Vector3f> shown =
+      scene.mesh.triangles.empty() ? Subsample(scene.points, kSamples) : SampleMesh(scene.mesh, 20000);
+  scene.extent = RobustBounds(shown);
+  // The ground is fitted to the cloud when there is one: the mesh was made from it.
+  const std::vector<Eigen::Vector3f> ground_samples =
+      scene.points.empty() ? shown : Subsample(scene.points, kSamples);
   const std::optional<Eigen::Vector3d> cameras_up = CamerasUp(scene.sources);
   const GroundPlaneOptions options;
-  scene.ground = FitGroundPlane(samples, cameras_up, options);
+  scene.ground = FitGroundPlane(ground_samples, cameras_up, options);
   scene.up = scene.ground ? scene.ground->normal : cameras_up.value_or(Eigen::Vector3d::UnitZ());
   // Mesh vertices too: area-weighted samples of a scene with a vast ground miss small objects.
-  samples.insert(samples.end(), scene.mesh.vertices.begin(), scene.mesh.vertices.end());
-  scene.focus = FocusBounds(samples, scene.ground, static_cast<float>(options.inlier_fraction_of_size) * scene.Radius() * 2);
-  if (scene.focus.isEmpty()) scene.focus = scene.bounds;
+  shown.insert(shown.end(), scene.mesh.vertices.begin(), scene.mesh.vertices.end());
+  scene.focus = FocusBounds(shown, scene.ground, static_cast<float>(options.inlier_fraction_of_size) * scene.Radius() * 2);
+  if (scene.focus.isEmpty()) scene.focus = scene.extent;
+  // A vast ground can outweigh what stands on it (2% of the samples): keep that in the extent.
+  scene.extent.extend(scene.focus);
+  scene.rig = FitCameraRig(scene.sources, scene.up, scene.extent);
 }
 
 ViewerScene LoadViewerScene(const fs::path& workspace) {

@@ -33,20 +33,35 @@ struct ColouredPoint {
   std::array<uint8_t, 3> colour;   // sRGB.
 };
 
+// Where the source cameras stand when they surround the scene looking in (a ring, a dome, an
+// arc): the orbit that frames the scene as the photos do.
+struct CameraRig {
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();  // The point nearest every optical axis.
+  double distance = 0;       // Median distance of the cameras to the target (scene units).
+  double elevation_deg = 0;  // Median elevation of the cameras seen from the target.
+  double half_width_tan = 0; // Median tan of the photos' horizontal half field of view.
+};
+
 struct ViewerScene {
   TexturedMesh mesh;                 // No triangles when the workspace has no mesh.
   std::vector<ColouredPoint> points; // Empty when the workspace has no fused.ply.
   std::vector<SourceView> sources;
-  Eigen::AlignedBox3f bounds;        // Of the mesh and the points.
+  Eigen::AlignedBox3f bounds;        // Exact bounds of the mesh and the points: for clipping.
+  // Robust bounds (RobustBounds, 2% outliers a side) of what is shown: the mesh (area-weighted
+  // samples) when there is one, else the points; merged with `focus`. Far outliers of a fused
+  // cloud do not count. The grid, the shadow map and the size of the camera frusta follow it.
+  Eigen::AlignedBox3f extent;
   std::optional<GroundPlane> ground; // Absent when no plane has enough support.
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // Unit; the ground's normal when found.
 
-  // What the views frame: the bounds of what stands on the ground (and its footprint), so a
-  // large ground plane does not shrink the objects to a few pixels; `bounds` without a ground.
+  // What the views frame: the robust bounds of what stands on the ground (and its footprint),
+  // so a large ground plane does not shrink the objects to a few pixels; `extent` without a
+  // ground.
   Eigen::AlignedBox3f focus;
+  std::optional<CameraRig> rig;  // Absent without cameras surrounding the scene.
 
-  Eigen::Vector3f Centre() const { return bounds.center(); }
-  float Radius() const { return 0.5f * bounds.diagonal().norm(); }
+  Eigen::Vector3f Centre() const { return extent.center(); }
+  float Radius() const { return 0.5f * extent.diagonal().norm(); }
   Eigen::Vector3f FocusCentre() const { return focus.center(); }
   float FocusRadius() const { return 0.5f * focus.diagonal().norm(); }
 };
@@ -58,8 +73,8 @@ struct ViewerScene {
 // file that is unreadable.
 ViewerScene LoadViewerScene(const std::filesystem::path& workspace);
 
-// Computes the bounds, fits the ground plane (to the cloud, else to points sampled on the mesh)
-// and the up direction. Call after filling mesh, points and sources by hand (tests).
+// Computes the bounds and the robust extent, fits the ground plane (to the cloud, else to points
+// sampled on the mesh), the up direction, the focus and the camera rig. Call after filling mesh, points and sources by hand (tests).
 // Throws BadInputError if the scene has neither triangles nor points.
 void FinishViewerScene(ViewerScene& scene);
 
@@ -67,5 +82,11 @@ void FinishViewerScene(ViewerScene& scene);
 // and COLMAP's): float x y z, optional float nx ny nz, optional uchar red green blue.
 // Throws BadInputError naming the file.
 std::vector<ColouredPoint> ReadColouredPly(const std::filesystem::path& path);
+
+// The rig of cameras looking in at a common point: nullopt with fewer than 3 cameras, when
+// their optical axes do not converge (e.g. a walk looking ahead), or when the point they
+// converge to is behind most of them or farther than half `extent`'s diagonal outside it. Pure.
+std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, const Eigen::Vector3d& up,
+                                      const Eigen::AlignedBox3f& extent);
 
 }  // namespace parallax

@@ -45,6 +45,7 @@ struct WindowState {
   RenderSettings settings;
   double azimuth_deg = 30, elevation_deg = 25, distance = 1;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  Orbit home;  // Where R goes back to.
   double light_azimuth_deg = 45, light_elevation_deg = 50;
   std::optional<int> source;  // Looking through this source camera until the mouse moves it.
   bool dragging_orbit = false, dragging_pan = false;
@@ -104,7 +105,9 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
       break;
     case GLFW_KEY_R:
       s.source.reset();
-      s.target = s.scene->FocusCentre().cast<double>();
+      s.target = s.home.target;
+      s.distance = s.home.distance;
+      s.elevation_deg = s.home.elevation_deg;
       break;
     default: break;
   }
@@ -212,10 +215,12 @@ void RunViewerWindow(const ViewerScene& scene, RenderSettings settings, const Wi
   state.scene = &scene;
   state.settings = settings;
   state.azimuth_deg = options.azimuth_deg;
-  state.elevation_deg = options.elevation_deg;
   state.fov_deg = options.fov_deg;
-  state.target = scene.FocusCentre().cast<double>();
-  state.distance = 2.5 * static_cast<double>(scene.FocusRadius());
+  state.home = DefaultOrbit(scene, options.azimuth_deg, options.elevation_deg,
+                            ViewerCamera(options.width, options.height, options.fov_deg));
+  state.target = state.home.target;
+  state.distance = state.home.distance;
+  state.elevation_deg = state.home.elevation_deg;
   state.source = start_source;
   UpdateLight(state);
   glfwSetWindowUserPointer(glfw.window, &state);

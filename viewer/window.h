@@ -15,8 +15,8 @@ struct WindowOptions {
   int width = 1280;        // Initial window size in screen pixels.
   int height = 720;
   double fov_deg = 50;     // Horizontal field of view of the orbit camera.
-  double azimuth_deg = 30; // Initial orbit.
-  double elevation_deg = 25;
+  double azimuth_deg = 30; // Initial orbit (DefaultOrbit).
+  std::optional<double> elevation_deg;  // Default: the source cameras' elevation, else 30.
   void Check() const;      // Throws std::invalid_argument naming the field.
 };
 

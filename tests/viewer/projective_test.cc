@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -9,7 +10,9 @@
 #include "core/sparse_model.h"
 #include "tests/temp_dir.h"
 #include "tests/viewer/viewer_test_util.h"
+#include "viewer/robust_bounds.h"
 #include "viewer/view_cameras.h"
+#include "viewer/view_math.h"
 
 namespace parallax {
 namespace {
@@ -90,6 +93,95 @@ TEST(ViewerScene, EmptyWorkspaceIsBadInputNamingTheFolder) {
     EXPECT_NE(std::string(error.what()).find(dir.Path().string()), std::string::npos) << error.what();
     EXPECT_NE(std::string(error.what()).find("fused.ply"), std::string::npos) << error.what();
   }
+}
+
+TEST(ViewerScene, RobustBoundsIgnoreOnePercentOfFarOutliers) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> x(-5, 5), y(-3, 3), z(0, 2);
+  std::vector<Eigen::Vector3f> points;
+  for (int i = 0; i < 9900; ++i) points.emplace_back(x(random), y(random), z(random));
+  // 1%: half of them 1000 units away on one side, half on the other.
+  for (int i = 0; i < 100; ++i) points.emplace_back((i % 2 ? 1000.0f : -700.0f) + x(random), -400, 900);
+  const Eigen::AlignedBox3f box = RobustBounds(points);
+  EXPECT_LT((box.min() - Eigen::Vector3f(-5, -3, 0)).norm(), 0.1f) << box.min().transpose();
+  EXPECT_LT((box.max() - Eigen::Vector3f(5, 3, 2)).norm(), 0.1f) << box.max().transpose();
+  EXPECT_TRUE(RobustBounds({}).isEmpty());
+  const Eigen::AlignedBox3f exact = RobustBounds(points, 0);
+  EXPECT_FLOAT_EQ(exact.max().z(), 900);
+  EXPECT_THROW(RobustBounds(points, 0.5f), std::invalid_argument);
+}
+
+// A fused cloud of a 20 x 20 courtyard with a block on it, plus 0.5% of points strewn up to
+// 40 scene sizes away: the extent, the grid and the framing follow the courtyard.
+TEST(ViewerScene, FarOutliersOfTheCloudDoNotShrinkTheScene) {
+  ViewerScene scene;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> ground(-10, 10), block(-2, 2), height(0, 3), far(-800, 800);
+  for (int i = 0; i < 40000; ++i) {
+    ColouredPoint p{{ground(random), ground(random), 0}, {0, 0, 1}, {128, 128, 128}};
+    if (i % 4 == 0) p.position = {block(random), block(random), height(random)};
+    if (i % 200 == 0) p.position = {far(random), far(random), std::abs(far(random))};
+    scene.points.push_back(p);
+  }
+  FinishViewerScene(scene);
+  ASSERT_TRUE(scene.ground.has_value());
+  EXPECT_GT(scene.bounds.diagonal().norm(), 500);
+  EXPECT_LT((scene.extent.min() - Eigen::Vector3f(-10, -10, 0)).norm(), 0.5f) << scene.extent.min().transpose();
+  EXPECT_LT((scene.extent.max() - Eigen::Vector3f(10, 10, 3)).norm(), 0.5f) << scene.extent.max().transpose();
+  EXPECT_LT((scene.focus.max() - Eigen::Vector3f(2, 2, 3)).norm(), 0.5f) << scene.focus.max().transpose();
+  // The orbit frames the block: its distance is a few block sizes, not hundreds of units.
+  const ViewCamera view = OrbitViewCamera(scene, 30, 30, 640, 480, 50);
+  const double distance = (CameraCenter(view.cam_from_world) - Eigen::Vector3d(0, 0, 1.5)).norm();
+  EXPECT_GT(distance, 4);
+  EXPECT_LT(distance, 20);
+}
+
+TEST(ViewerScene, OrbitLooksWhereTheSourceCamerasLookFromAsFar) {
+  const ViewerScene scene = SmallScene();
+  ASSERT_TRUE(scene.rig.has_value()) << "the small scene's cameras stand on an arc looking in";
+  // Every camera of the arc is 5.46 from its centre of interest.
+  for (const SourceView& source : scene.sources) {
+    EXPECT_NEAR((CameraCenter(source.cam_from_world) - scene.rig->target).norm(), scene.rig->distance, 0.05);
+  }
+  // With the photos' own field of view, the default orbit at a camera's azimuth and elevation
+  // stands where that camera stands.
+  const SourceView& source = scene.sources[4];
+  const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - scene.rig->target;
+  const double azimuth_deg = std::atan2(offset.y(), offset.x()) * 180 / std::numbers::pi;
+  const double fov_deg = 2 * std::atan(0.5 * static_cast<double>(source.camera.width) / source.camera.FocalX()) * 180 /
+                         std::numbers::pi;
+  const ViewCamera view = OrbitViewCamera(scene, azimuth_deg, std::nullopt, 320, 240, fov_deg);
+  EXPECT_LT((CameraCenter(view.cam_from_world) - CameraCenter(source.cam_from_world)).norm(), 0.1);
+  // Cameras all looking ahead, as on a walk, make no rig.
+  std::vector<SourceView> walk;
+  for (int i = 0; i < 10; ++i) {
+    walk.push_back(scene.sources[0]);
+    walk.back().cam_from_world = LookAt(Eigen::Vector3d(i, 0, 1), Eigen::Vector3d(i + 5, 0, 1), Eigen::Vector3d::UnitZ());
+  }
+  EXPECT_FALSE(FitCameraRig(walk, Eigen::Vector3d::UnitZ(), scene.extent).has_value());
+}
+
+// Looking through a source camera: its own frustum and those next to it are not drawn, so the
+// frame differs from one without cameras only where farther frusta show.
+TEST(ViewerProjective, LookingThroughASourceCameraHidesItsFrustum) {
+  EnsureGlContext();
+  const ViewerScene scene = SmallScene();
+  Renderer renderer(scene);
+  RenderSettings settings;
+  settings.shadows = ShadowMode::kNone;
+  settings.show_grid = false;
+  const ViewCamera view = SourceViewCamera(scene, "0006");
+  const RenderResult with = renderer.Render(view, settings);
+  settings.show_cameras = false;
+  const RenderResult without = renderer.Render(view, settings);
+  int different = 0;
+  for (int y = 0; y < with.colour.Height(); ++y) {
+    for (int x = 0; x < with.colour.Width(); ++x) {
+      different += (with.colour.At(x, y, 0) != without.colour.At(x, y, 0));
+    }
+  }
+  std::printf("[ measure ] frusta seen from camera 0006: %d pixels\n", different);
+  EXPECT_LT(different, with.colour.Width() * with.colour.Height() / 100);
 }
 
 TEST(ViewerScene, GroundPlaneIsFoundDespiteOutliers) {
