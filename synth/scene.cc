@@ -262,12 +262,13 @@ SceneDesc ParseSceneJson(const std::string& json_text, const std::string& source
   Json json;
   try {
     json = Json::parse(json_text);
-  } catch (const Json::parse_error& error) {
-    // nlohmann's message carries "line L, column C" and what was expected.
+  } catch (const Json::exception& error) {
+    // A syntax error (nlohmann's message carries "line L, column C" and what was expected),
+    // or a number too large to represent (found by fuzzing: "7777...e777" overflows).
     std::string message = error.what();
-    const size_t start = message.find("parse error");
+    const size_t start = message.find("] ");
     throw BadInputError(source_name + ": " +
-                        (start == std::string::npos ? message : message.substr(start)));
+                        (start == std::string::npos ? message : message.substr(start + 2)));
   }
   const Node root(json, "", source_name);
   root.AllowOnly({"image", "sky", "ambient", "write_normals", "materials", "objects", "lights",
