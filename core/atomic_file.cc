@@ -56,6 +56,10 @@ void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
 }
 
 std::string ReadFileBytes(const fs::path& path) {
+  // A folder opens as a stream but throws on reading (found by fuzzing: an OBJ whose mtllib
+  // names a folder).
+  std::error_code error;
+  if (fs::is_directory(path, error)) throw BadInputError(path.string() + " is a folder, not a file");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw BadInputError("cannot open " + path.string());
   std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
