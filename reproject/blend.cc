@@ -11,52 +11,89 @@
 namespace parallax {
 namespace {
 
-float SampleWeight(const WarpWeight& weight, float angle_epsilon) {
-  return 1.0f / ((weight.ray_angle_rad + angle_epsilon) * std::max(1.0f, weight.stretch));
-}
-
-struct Accumulator {
-  float rgb[3] = {0, 0, 0};
-  float depth = 0;
-  float weight = 0;
-
-  void Add(const WarpBuffer& buffer, size_t i, float depth_value, float angle_epsilon) {
-    const float w = SampleWeight(buffer.Weight(i), angle_epsilon);
-    const float* color = buffer.Color(i);
-    for (int k = 0; k < 3; ++k) rgb[k] += w * color[k];
-    depth += w * depth_value;
-    weight += w;
-  }
-};
-
-void BlendPixel(const std::vector<WarpBuffer>& buffers, size_t i, float tolerance,
-                float angle_epsilon, BlendResult* out) {
-  float front = WarpBuffer::kBackground;
-  bool any_background = false;
+// One row of the blend, buffer after buffer (each buffer's row is read as a stream).
+// `scratch` is resized to 7 floats per pixel of the row.
+void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance,
+              float angle_epsilon, int min_support, std::vector<float>* scratch,
+              BlendResult* out) {
+  const size_t width = static_cast<size_t>(out->color.Width());
+  const size_t row = static_cast<size_t>(y) * width;
+  scratch->assign(7 * width, 0.0f);
+  float* front = scratch->data();             // Front-most surface depth; +inf: none.
+  float* rgb_sum = front + width;             // Interleaved.
+  float* depth_sum = rgb_sum + 3 * width;
+  float* weight = depth_sum + width;
+  float* any_background = weight + width;     // 1 where a background sample landed.
+  std::fill(front, front + width, WarpBuffer::kBackground);
+  float* back = depth_sum;  // Farthest surface depth; 0: none (depth_sum is zeroed below).
   for (const WarpBuffer& buffer : buffers) {
-    const float depth = buffer.Depth(i);
-    if (depth == WarpBuffer::kBackground) {
-      any_background = true;
-    } else if (depth > 0) {
-      front = std::min(front, depth);
+    const float* depth = buffer.Depths() + row;
+    for (size_t x = 0; x < width; ++x) {
+      const float d = depth[x];
+      if (d == WarpBuffer::kBackground) any_background[x] = 1.0f;
+      if (d > 0 && d < front[x]) front[x] = d;
+      if (d != WarpBuffer::kBackground && d > back[x]) back[x] = d;
     }
   }
-  const bool surface = front != WarpBuffer::kBackground;
-  if (!surface && !any_background) return;
-  Accumulator sum;
-  const float limit = front * (1.0f + tolerance);
-  for (const WarpBuffer& buffer : buffers) {
-    const float depth = buffer.Depth(i);
-    const bool take = surface ? (depth > 0 && depth <= limit) : depth == WarpBuffer::kBackground;
-    if (take) sum.Add(buffer, i, surface ? depth : 0.0f, angle_epsilon);
+  if (min_support > 1 && buffers.size() > 1) {
+    // The front-most surface that min_support sources agree on (where as many have a
+    // surface sample here): a sample in front of what the others agree on, seen by it alone,
+    // is more likely a depth error than an occluder the others all miss. Only where the
+    // samples disagree (most pixels hold one surface).
+    for (size_t x = 0; x < width; ++x) {
+      if (front[x] == WarpBuffer::kBackground || back[x] <= front[x] * (1.0f + tolerance)) continue;
+      float surfaces[16];
+      size_t n = 0;
+      for (const WarpBuffer& buffer : buffers) {
+        const float d = buffer.Depths()[row + x];
+        if (d > 0 && d != WarpBuffer::kBackground && n < 16) surfaces[n++] = d;
+      }
+      const size_t need = std::min(n, static_cast<size_t>(min_support));
+      float best = WarpBuffer::kBackground;
+      for (size_t a = 0; a < n; ++a) {
+        size_t support = 0;
+        for (size_t b = 0; b < n; ++b) {
+          support += std::abs(surfaces[b] - surfaces[a]) <= tolerance * surfaces[a] ? 1 : 0;
+        }
+        if (support >= need && surfaces[a] < best) best = surfaces[a];
+      }
+      // No two agree: the front-most, as without support.
+      if (best != WarpBuffer::kBackground) front[x] = best;
+    }
   }
-  // Weights are positive and finite (angles >= 0, epsilon > 0); guard anyway so a degenerate
-  // sample can never write NaN.
-  if (!(sum.weight > 0) || !std::isfinite(sum.weight)) return;
-  float* rgb = out->color.Pixels().data() + 3 * i;
-  for (int k = 0; k < 3; ++k) rgb[k] = sum.rgb[k] / sum.weight;
-  out->depth.Values()[i] = surface ? sum.depth / sum.weight : 0.0f;
-  out->kind[i] = surface ? SampleKind::kSurface : SampleKind::kBackground;
+  std::fill(depth_sum, depth_sum + width, 0.0f);
+  for (const WarpBuffer& buffer : buffers) {
+    const float* depth = buffer.Depths() + row;
+    for (size_t x = 0; x < width; ++x) {
+      const float d = depth[x];
+      if (d == 0) continue;
+      const bool surface = front[x] != WarpBuffer::kBackground;
+      const bool take = surface ? d <= front[x] * (1.0f + tolerance) : d == WarpBuffer::kBackground;
+      if (!take) continue;
+      const WarpWeight& ww = buffer.Weight(row + x);
+      const float w =
+          1.0f / ((ww.ray_angle_rad + angle_epsilon) * std::max(1.0f, ww.stretch));
+      const float* color = buffer.Color(row + x);
+      for (int k = 0; k < 3; ++k) rgb_sum[3 * x + static_cast<size_t>(k)] += w * color[k];
+      if (surface) depth_sum[x] += w * d;
+      weight[x] += w;
+    }
+  }
+  float* rgb_out = out->color.Pixels().data() + 3 * row;
+  float* depth_out = out->depth.Values().data() + row;
+  SampleKind* kind_out = out->kind.data() + row;
+  for (size_t x = 0; x < width; ++x) {
+    const bool surface = front[x] != WarpBuffer::kBackground;
+    // Weights are positive and finite (angles >= 0, epsilon > 0); guard anyway so a
+    // degenerate sample can never write NaN.
+    if ((!surface && any_background[x] == 0.0f) || !(weight[x] > 0) || !std::isfinite(weight[x])) {
+      continue;
+    }
+    const float inv = 1.0f / weight[x];
+    for (int k = 0; k < 3; ++k) rgb_out[3 * x + static_cast<size_t>(k)] = rgb_sum[3 * x + static_cast<size_t>(k)] * inv;
+    depth_out[x] = surface ? depth_sum[x] * inv : 0.0f;
+    kind_out[x] = surface ? SampleKind::kSurface : SampleKind::kBackground;
+  }
 }
 
 }  // namespace
@@ -65,6 +102,10 @@ void BlendOptions::Check() const {
   if (!(depth_tolerance > 0 && depth_tolerance < 1)) {
     throw std::invalid_argument("BlendOptions.depth_tolerance = " +
                                 std::to_string(depth_tolerance) + ": expected (0, 1)");
+  }
+  if (min_support < 1 || min_support > 16) {
+    throw std::invalid_argument("BlendOptions.min_support = " + std::to_string(min_support) +
+                                ": expected [1, 16]");
   }
   if (!(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad))) {
     throw std::invalid_argument("BlendOptions.angle_epsilon_rad = " +
@@ -90,12 +131,11 @@ BlendResult Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& op
   out.kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
   const float tolerance = static_cast<float>(options.depth_tolerance);
   const float angle_epsilon = static_cast<float>(options.angle_epsilon_rad);
+  const int min_support = options.min_support;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> scratch;
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
-      for (int x = 0; x < width; ++x) {
-        BlendPixel(buffers, row + static_cast<size_t>(x), tolerance, angle_epsilon, &out);
-      }
+      BlendRow(buffers, y, tolerance, angle_epsilon, min_support, &scratch, &out);
     }
   });
   return out;

@@ -17,6 +17,12 @@ struct BlendOptions {
   // source that sees the point exactly along the target ray gets a large, finite weight
   // (radians, > 0).
   double angle_epsilon_rad = 0.01;
+  // The surface blended at a pixel is the front-most one that this many sources' samples
+  // agree on (within depth_tolerance; fewer where fewer sources landed there; the front-most
+  // sample when no two agree). A sample in front of what the others agree on is more often a
+  // depth error of its source than an occluder only it sees. 1: always the front-most; in
+  // [1, 16].
+  int min_support = 2;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
@@ -35,8 +41,8 @@ struct BlendResult {
   }
 };
 
-// Per pixel: the front-most surface depth over all buffers; the surface samples within
-// depth_tolerance of it are averaged in linear light with Unstructured-Lumigraph-style
+// Per pixel: the front-most surface depth over all buffers (with min_support); the surface
+// samples within depth_tolerance of it are averaged in linear light with Unstructured-Lumigraph-style
 // weights (smaller angle between source and target rays, less stretch -> larger weight).
 // Background samples are blended only where no surface sample landed. Parallel over rows.
 // Throws std::invalid_argument for no buffers or buffers of different sizes.

@@ -42,22 +42,28 @@ class DepthAwareFiller {
 
   // Reads only pixels with samples and writes only the pixel itself (which has none), so rows
   // can be filled in parallel in place.
-  bool FillPixel(int x, int y) {
+  // `hidden_surface`: the pixel is a hole, where the ray reaches something the sources see
+  // behind what is in front of it; background at infinity is taken only when no surface is
+  // found (else sky next to a disoccluded wall top would win as "farthest").
+  bool FillPixel(int x, int y, bool hidden_surface) {
     std::array<Candidate, kMaxDirections> candidates;
     int found = 0;
-    float farthest = 0;
+    float farthest = 0, farthest_surface = 0;
     for (int k = 0; k < count_; ++k) {
       if (!March(x, y, dir_[static_cast<size_t>(k)], &candidates[static_cast<size_t>(found)])) continue;
-      farthest = std::max(farthest, candidates[static_cast<size_t>(found)].depth);
+      const float depth = candidates[static_cast<size_t>(found)].depth;
+      farthest = std::max(farthest, depth);
+      if (!std::isinf(depth)) farthest_surface = std::max(farthest_surface, depth);
       ++found;
     }
     if (found == 0) return false;
+    if (hidden_surface && farthest_surface > 0) farthest = farthest_surface;
     const bool background = std::isinf(farthest);
     const float limit = background ? farthest : farthest * (1.0f - tolerance_);
     float rgb[3] = {0, 0, 0}, depth = 0, weight = 0;
     for (int k = 0; k < found; ++k) {
       const Candidate& c = candidates[static_cast<size_t>(k)];
-      if (!(c.depth >= limit)) continue;
+      if (!(c.depth >= limit) || (!background && std::isinf(c.depth))) continue;
       const float w = 1.0f / c.distance_px;
       for (int ch = 0; ch < 3; ++ch) rgb[ch] += w * c.rgb[ch];
       if (!background) depth += w * c.depth;
@@ -106,7 +112,8 @@ int FillDepthAware(const ClassMap& classes, const FillOptions& options, BlendRes
   std::vector<int> filled_per_row(static_cast<size_t>(classes.height), 0);
   tbb::parallel_for(0, classes.height, [&](int y) {
     for (int x = 0; x < classes.width; ++x) {
-      if (ShouldFill(classes.At(x, y), options) && filler.FillPixel(x, y)) {
+      const PixelClass pixel_class = classes.At(x, y);
+      if (ShouldFill(pixel_class, options) && filler.FillPixel(x, y, IsHole(pixel_class))) {
         ++filled_per_row[static_cast<size_t>(y)];
       }
     }

@@ -36,8 +36,9 @@ struct FillSummary {
 // Fills the pixels of `blend` where nothing landed (holes; out-of-view ones too with
 // fill_out_of_view). kDepthAware scans `directions` rays from the pixel to the nearest pixel
 // with a sample, keeps the candidates whose depth is the farthest (background at infinity
-// counts as farthest) within background_tolerance, and averages their colours weighted by
-// inverse distance; surface fills also get that averaged depth. A disocclusion is hidden
+// counts as farthest, except for holes, where it is taken only when no surface candidate is
+// found) within background_tolerance, and averages their colours weighted by inverse
+// distance; surface fills also get that averaged depth. A disocclusion is hidden
 // background, so its colour comes from the background side, not from the occluder. The
 // sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad options
 // or a class map of another size.

@@ -10,9 +10,15 @@
 #include <tbb/parallel_for.h>
 
 #include "reproject/background.h"
+#include "reproject/rasterizer.h"
 
 namespace parallax {
 namespace {
+
+using warp_internal::Corner;
+using warp_internal::Finite;
+using warp_internal::kFloatMax;
+using warp_internal::Rasterizer;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -26,6 +32,7 @@ struct Vertices {
   std::unique_ptr<float[]> v;
   std::unique_ptr<float[]> inv_z;   // 1 / target z; 0 for background.
   std::unique_ptr<float[]> angle;   // WarpWeight::ray_angle_rad.
+  std::unique_ptr<float[]> source_inv_depth;  // 1 / source depth; 0 where depth is 0.
   std::unique_ptr<uint8_t[]> kind;  // VertexKind.
   size_t capacity = 0;
 };
@@ -35,6 +42,7 @@ struct WarpScratch::Data {
   std::vector<uint8_t> background;  // MarkBackground.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
   std::vector<uint8_t> edge;        // Mesh: vertices to splat.
+  std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
 };
 
@@ -50,15 +58,6 @@ struct WarpSetup {
   float max_depth_ratio;  // Between samples of one surface (mesh and splat footprints).
 };
 
-bool Finite(float value) { return std::abs(value) <= std::numeric_limits<float>::max(); }
-
-// floor and ceil for values >= -1 by truncation: std::floor is a library call without SSE4.1,
-// and these run several times per triangle.
-int FloorClamped(float value) { return static_cast<int>(value + 1.0f) - 1; }
-int CeilClamped(float value) {
-  const int floor = FloorClamped(value);
-  return static_cast<float>(floor) < value ? floor + 1 : floor;
-}
 
 WarpSetup MakeSetup(const SourceView& source, const PosedCamera& target,
                     const ForwardWarpOptions& options) {
@@ -78,236 +77,121 @@ WarpSetup MakeSetup(const SourceView& source, const PosedCamera& target,
   return setup;
 }
 
-// Maps one source row into the target. Surfaces are lifted at their depth; background pixels
-// are rotated only (a direction has no position, so the baseline does not move it).
-void ProjectRow(const WarpSetup& s, const SourceView& source,
-                const std::vector<uint8_t>& background, const std::vector<float>& ray_x, int y,
-                Vertices* out) {
-  const int width = s.src.width;
-  const float ray_y = static_cast<float>((y + 0.5 - s.src.cy) / s.src.fy);
-  // Rotated source ray (x, y, 1) = ray_x * column 0 + base.
-  const float base[3] = {ray_y * s.r[0][1] + s.r[0][2], ray_y * s.r[1][1] + s.r[1][2],
-                         ray_y * s.r[2][1] + s.r[2][2]};
-  const float fx = static_cast<float>(s.dst.fx), fy = static_cast<float>(s.dst.fy);
-  const float cx = static_cast<float>(s.dst.cx), cy = static_cast<float>(s.dst.cy);
-  const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
-  for (int x = 0; x < width; ++x) {
-    const size_t i = row + static_cast<size_t>(x);
-    const float dir[3] = {ray_x[static_cast<size_t>(x)] * s.r[0][0] + base[0],
-                          ray_x[static_cast<size_t>(x)] * s.r[1][0] + base[1],
-                          ray_x[static_cast<size_t>(x)] * s.r[2][0] + base[2]};
-    const float depth = source.depth.At(x, y);
-    out->kind[i] = kInvalid;
-    float p[3];
-    float angle = 0;
-    uint8_t kind = kInvalid;
-    if (depth > 0 && Finite(depth)) {
-      for (int k = 0; k < 3; ++k) p[k] = depth * dir[k] + s.t[k];
-      const float norm_p = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      const float norm_dir = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-      if (!(p[2] > s.min_view_cos * norm_p) || !Finite(norm_p)) continue;
-      // Chord between the unit rays from the target centre (p) and the source centre (dir).
-      float chord2 = 0;
-      for (int k = 0; k < 3; ++k) {
-        const float diff = p[k] / norm_p - dir[k] / norm_dir;
-        chord2 += diff * diff;
-      }
-      angle = std::sqrt(chord2);
-      kind = kSurface;
-    } else if (depth == 0 && !background.empty() && background[i] != 0) {
-      for (int k = 0; k < 3; ++k) p[k] = dir[k];
-      const float norm_p = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-      if (!(p[2] > s.min_view_cos * norm_p)) continue;
-      kind = kSky;
-    } else {
-      continue;
-    }
-    const float inv_z = 1.0f / p[2];
-    const float u = fx * p[0] * inv_z + cx;
-    const float v = fy * p[1] * inv_z + cy;
-    if (!Finite(u) || !Finite(v) || !Finite(inv_z)) continue;
-    out->u[i] = u;
-    out->v[i] = v;
-    out->inv_z[i] = kind == kSurface ? inv_z : 0.0f;
-    out->angle[i] = angle;
-    out->kind[i] = kind;
+// The per-row constants of ProjectSpan.
+struct RowProjection {
+  float base0, base1, base2;  // Rotated source ray (x, y, 1) = ray_x * r_0 + base.
+  float r00, r10, r20;
+  float t0, t1, t2;
+  float fx, fy, cx, cy;
+  float min_view_cos;
+};
+
+// n pixels of a row. Written without branches (every pixel computed, then kept or marked
+// invalid) and with __restrict arrays (no run-time alias checks) so that it vectorises; masks
+// are int32 (a loop mixing float and byte lanes does not vectorise on SSE2).
+void ProjectSpan(int n, const RowProjection& c, const float* __restrict ray_x,
+                 const float* __restrict depth_in, const int32_t* __restrict sky_in,
+                 float* __restrict out_u, float* __restrict out_v, float* __restrict out_inv_z,
+                 float* __restrict out_angle, float* __restrict out_source_inv_depth,
+                 int32_t* __restrict out_kind) {
+  for (int k = 0; k < n; ++k) {
+    const float dir0 = ray_x[k] * c.r00 + c.base0;
+    const float dir1 = ray_x[k] * c.r10 + c.base1;
+    const float dir2 = ray_x[k] * c.r20 + c.base2;
+    const float depth = depth_in[k];
+    const int surface = static_cast<int>(depth > 0) & static_cast<int>(depth <= kFloatMax);
+    const int sky = static_cast<int>(depth == 0) & static_cast<int>(sky_in[k] != 0);
+    // Background: the direction itself (scale 1, no translation).
+    const float scale = surface != 0 ? depth : 1.0f;
+    const float shift = surface != 0 ? 1.0f : 0.0f;
+    const float p0 = scale * dir0 + shift * c.t0;
+    const float p1 = scale * dir1 + shift * c.t1;
+    const float p2 = scale * dir2 + shift * c.t2;
+    const float norm_p = std::sqrt(p0 * p0 + p1 * p1 + p2 * p2);
+    const float norm_dir = std::sqrt(dir0 * dir0 + dir1 * dir1 + dir2 * dir2);
+    // Chord between the unit rays from the target centre (p) and the source centre (dir).
+    const float inv_norm_p = 1.0f / norm_p, inv_norm_dir = 1.0f / norm_dir;
+    const float e0 = p0 * inv_norm_p - dir0 * inv_norm_dir;
+    const float e1 = p1 * inv_norm_p - dir1 * inv_norm_dir;
+    const float e2 = p2 * inv_norm_p - dir2 * inv_norm_dir;
+    const float angle = std::sqrt(e0 * e0 + e1 * e1 + e2 * e2);
+    const float inv_z = 1.0f / p2;
+    const float u = c.fx * p0 * inv_z + c.cx;
+    const float v = c.fy * p1 * inv_z + c.cy;
+    // Comparisons with NaN are false, so these also reject NaN.
+    const int finite = static_cast<int>(std::abs(u) <= kFloatMax) &
+                       static_cast<int>(std::abs(v) <= kFloatMax) &
+                       static_cast<int>(std::abs(inv_z) <= kFloatMax) &
+                       static_cast<int>(norm_p <= kFloatMax);
+    const int ok = (surface | sky) & static_cast<int>(p2 > c.min_view_cos * norm_p) & finite;
+    out_u[k] = u;
+    out_v[k] = v;
+    out_inv_z[k] = surface != 0 ? inv_z : 0.0f;
+    out_angle[k] = (surface & ok) != 0 ? angle : 0.0f;
+    out_source_inv_depth[k] = surface != 0 ? 1.0f / depth : 0.0f;
+    out_kind[k] = ok * (kSky - surface);
   }
 }
 
-// A vertex as the rasteriser reads it.
-struct Corner {
-  float u, v, inv_z, angle;
-  const float* rgb;
-};
-
-// Writes samples of one source into the target buffer (z-test: nearest surface wins;
-// background only where nothing is).
-class Rasterizer {
- public:
-  Rasterizer(WarpBuffer* buffer, int32_t source_index)
-      : width_(buffer->Width()),
-        height_(buffer->Height()),
-        depth_(buffer->MutableDepth()),
-        color_(buffer->MutableColor()),
-        weight_(buffer->MutableWeight()),
-        source_(source_index) {}
-
-  // Perspective-correct: inverse depth is affine in the image, attributes / z too.
-  void SurfaceTriangle(const Corner& a, const Corner& b, const Corner& c) {
-    Box box;
-    float inv_area;
-    if (!Setup(a, b, c, &box, &inv_area)) return;
-    const float stretch = Stretch(inv_area);
-    for (int y = box.y0; y <= box.y1; ++y) {
-      for (int x = box.x0; x <= box.x1; ++x) ShadeSurface(a, b, c, x, y, inv_area, stretch);
-    }
+// Maps one source row into the target. Surfaces are lifted at their depth; background pixels
+// are rotated only (a direction has no position, so the baseline does not move it).
+void ProjectRow(const WarpSetup& s, const SourceView& source, const uint8_t* background,
+                const float* ray_x, int y, Vertices* out) {
+  const int width = s.src.width;
+  const float ray_y = static_cast<float>((y + 0.5 - s.src.cy) / s.src.fy);
+  RowProjection c;
+  c.base0 = ray_y * s.r[0][1] + s.r[0][2];
+  c.base1 = ray_y * s.r[1][1] + s.r[1][2];
+  c.base2 = ray_y * s.r[2][1] + s.r[2][2];
+  c.r00 = s.r[0][0];
+  c.r10 = s.r[1][0];
+  c.r20 = s.r[2][0];
+  c.t0 = s.t[0];
+  c.t1 = s.t[1];
+  c.t2 = s.t[2];
+  c.fx = static_cast<float>(s.dst.fx);
+  c.fy = static_cast<float>(s.dst.fy);
+  c.cx = static_cast<float>(s.dst.cx);
+  c.cy = static_cast<float>(s.dst.cy);
+  c.min_view_cos = s.min_view_cos;
+  const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+  // The background bytes and the kinds go through int32 chunks.
+  constexpr int kChunk = 64;
+  int32_t kinds[kChunk], sky_in[kChunk];
+  for (int chunk = 0; chunk < width; chunk += kChunk) {
+    const int n = std::min(width - chunk, kChunk);
+    const size_t i = row + static_cast<size_t>(chunk);
+    for (int k = 0; k < n; ++k) sky_in[k] = background != nullptr ? background[i + static_cast<size_t>(k)] : 0;
+    ProjectSpan(n, c, ray_x + chunk, source.depth.Values().data() + i, sky_in, out->u.get() + i,
+                out->v.get() + i, out->inv_z.get() + i, out->angle.get() + i,
+                out->source_inv_depth.get() + i, kinds);
+    for (int k = 0; k < n; ++k) out->kind[i + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
   }
+}
 
-  // Triangles (a, b, c) and (b, d, c) of one quad of a continuous surface. Most quads cover
-  // zero or one pixel centre, so the bounding box is tested before any triangle setup, and a
-  // centre inside the first triangle is not tested against the second.
-  void SurfaceQuad(const Corner& a, const Corner& b, const Corner& c, const Corner& d) {
-    Box box;
-    if (!Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
-              std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
-              std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
-              std::max(std::max(a.v, b.v), std::max(c.v, d.v)), &box)) {
-      return;
-    }
-    const float area_1 = Area2(a, b, c), area_2 = Area2(b, d, c);
-    const bool valid_1 = std::abs(area_1) > kMinArea2, valid_2 = std::abs(area_2) > kMinArea2;
-    const float inv_1 = valid_1 ? 1.0f / area_1 : 0.0f, inv_2 = valid_2 ? 1.0f / area_2 : 0.0f;
-    for (int y = box.y0; y <= box.y1; ++y) {
-      for (int x = box.x0; x <= box.x1; ++x) {
-        if (!(valid_1 && ShadeSurface(a, b, c, x, y, inv_1, std::abs(area_1))) && valid_2) {
-          ShadeSurface(b, d, c, x, y, inv_2, std::abs(area_2));
-        }
-      }
-    }
+// Per quad of source row y (pixel centres (x, y) to (x + 1, y + 1)): kSurface when its four
+// samples are surface within max_depth_ratio of each other (one surface), kSky when all four
+// are background, else kInvalid.
+void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices& vtx, int y,
+                   uint8_t* out) {
+  const int width = s.src.width;
+  const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+  if (y + 1 >= s.src.height) {
+    std::fill(out + row, out + row + static_cast<size_t>(width), uint8_t{0});
+    return;
   }
-
-  // Directions: screen-affine interpolation (no depth); never covers a surface.
-  void BackgroundTriangle(const Corner& a, const Corner& b, const Corner& c) {
-    Box box;
-    float inv_area;
-    if (!Setup(a, b, c, &box, &inv_area)) return;
-    const float stretch = Stretch(inv_area);
-    for (int y = box.y0; y <= box.y1; ++y) {
-      const float pv = static_cast<float>(y) + 0.5f;
-      for (int x = box.x0; x <= box.x1; ++x) {
-        const float pu = static_cast<float>(x) + 0.5f;
-        float w[3];
-        if (!Barycentric(a, b, c, pu, pv, inv_area, w)) continue;
-        const size_t i = Index(x, y);
-        if (depth_[i] != 0) continue;
-        Write(i, WarpBuffer::kBackground, w, a, b, c, stretch);
-      }
-    }
+  const float* depth = source.depth.Values().data();
+  const size_t below = row + static_cast<size_t>(width);
+  for (int x = 0; x + 1 < width; ++x) {
+    const size_t a = row + static_cast<size_t>(x), c = below + static_cast<size_t>(x);
+    const bool surface = (vtx.kind[a] & vtx.kind[a + 1] & vtx.kind[c] & vtx.kind[c + 1]) == kSurface;
+    const float lo = std::min(std::min(depth[a], depth[a + 1]), std::min(depth[c], depth[c + 1]));
+    const float hi = std::max(std::max(depth[a], depth[a + 1]), std::max(depth[c], depth[c + 1]));
+    const bool sky = (vtx.kind[a] & vtx.kind[a + 1] & vtx.kind[c] & vtx.kind[c + 1]) == kSky;
+    out[a] = surface && hi <= s.max_depth_ratio * lo ? kSurface : sky ? kSky : kInvalid;
   }
-
-  // A square footprint of half-size (half_u, half_v) pixels around the corner.
-  void Splat(const Corner& a, float half_u, float half_v, float stretch, bool background) {
-    Box box;
-    if (!Clip(a.u - half_u, a.u + half_u, a.v - half_v, a.v + half_v, &box)) return;
-    const float z = background ? WarpBuffer::kBackground : 1.0f / a.inv_z;
-    if (!background && !Finite(z)) return;
-    const float q[3] = {1, 0, 0};
-    for (int y = box.y0; y <= box.y1; ++y) {
-      for (int x = box.x0; x <= box.x1; ++x) {
-        const size_t i = Index(x, y);
-        if (background ? depth_[i] != 0 : (depth_[i] != 0 && !(z < depth_[i]))) continue;
-        Write(i, z, q, a, a, a, stretch);
-      }
-    }
-  }
-
- private:
-  struct Box {
-    int x0, x1, y0, y1;
-  };
-
-  // Twice the signed area of a triangle below which it is degenerate (pixels squared).
-  static constexpr float kMinArea2 = 1e-12f;
-
-  size_t Index(int x, int y) const {
-    return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
-  }
-
-  // Source triangles have area 1/2, so the area ratio is twice the target area: |area2|.
-  static float Stretch(float inv_area) { return std::abs(1.0f / inv_area); }
-
-  static float Area2(const Corner& a, const Corner& b, const Corner& c) {
-    return (b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u);
-  }
-
-  // Writes pixel (x, y) from the triangle when its centre lies inside and passes the z-test;
-  // returns whether the centre lies inside.
-  // `stretch` is the triangle's WarpWeight::stretch.
-  bool ShadeSurface(const Corner& a, const Corner& b, const Corner& c, int x, int y,
-                    float inv_area, float stretch) {
-    float w[3];
-    if (!Barycentric(a, b, c, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f,
-                     inv_area, w)) {
-      return false;
-    }
-    const float inv_z = w[0] * a.inv_z + w[1] * b.inv_z + w[2] * c.inv_z;
-    if (!(inv_z > 0)) return true;
-    const float z = 1.0f / inv_z;
-    const size_t i = Index(x, y);
-    if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) return true;
-    const float q[3] = {w[0] * a.inv_z * z, w[1] * b.inv_z * z, w[2] * c.inv_z * z};
-    Write(i, z, q, a, b, c, stretch);
-    return true;
-  }
-
-  // Pixels whose centres lie in [u0, u1] x [v0, v1], clipped to the image. Coordinates are
-  // clamped as floats before the integer conversion so far-off vertices cannot overflow it.
-  bool Clip(float u0, float u1, float v0, float v1, Box* box) const {
-    const float w = static_cast<float>(width_), h = static_cast<float>(height_);
-    box->x0 = std::max(0, CeilClamped(std::clamp(u0 - 0.5f, -1.0f, w)));
-    box->x1 = std::min(width_ - 1, FloorClamped(std::clamp(u1 - 0.5f, -1.0f, w)));
-    box->y0 = std::max(0, CeilClamped(std::clamp(v0 - 0.5f, -1.0f, h)));
-    box->y1 = std::min(height_ - 1, FloorClamped(std::clamp(v1 - 0.5f, -1.0f, h)));
-    return box->x0 <= box->x1 && box->y0 <= box->y1;
-  }
-
-  bool Setup(const Corner& a, const Corner& b, const Corner& c, Box* box,
-             float* inv_area) const {
-    const float area2 = Area2(a, b, c);
-    if (!(std::abs(area2) > kMinArea2) || !Finite(area2)) return false;
-    if (!Clip(std::min({a.u, b.u, c.u}), std::max({a.u, b.u, c.u}),
-              std::min({a.v, b.v, c.v}), std::max({a.v, b.v, c.v}), box)) {
-      return false;
-    }
-    *inv_area = 1.0f / area2;
-    return true;
-  }
-
-  // Barycentric weights of the pixel centre; false outside the triangle. Edges are inclusive
-  // (with a hair of slack) so that no centre on a shared edge falls between two triangles.
-  static bool Barycentric(const Corner& a, const Corner& b, const Corner& c, float pu, float pv,
-                          float inv_area, float w[3]) {
-    constexpr float kSlack = -1e-5f;
-    w[0] = ((b.u - pu) * (c.v - pv) - (b.v - pv) * (c.u - pu)) * inv_area;
-    w[1] = ((c.u - pu) * (a.v - pv) - (c.v - pv) * (a.u - pu)) * inv_area;
-    w[2] = 1.0f - w[0] - w[1];
-    return w[0] >= kSlack && w[1] >= kSlack && w[2] >= kSlack;
-  }
-
-  void Write(size_t i, float depth, const float q[3], const Corner& a, const Corner& b,
-             const Corner& c, float stretch) {
-    depth_[i] = depth;
-    for (int k = 0; k < 3; ++k) color_[3 * i + k] = q[0] * a.rgb[k] + q[1] * b.rgb[k] + q[2] * c.rgb[k];
-    weight_[i] = WarpWeight{source_, q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch};
-  }
-
-  int width_;
-  int height_;
-  float* depth_;
-  float* color_;
-  WarpWeight* weight_;
-  int32_t source_;
-};
+  out[row + static_cast<size_t>(width) - 1] = 0;
+}
 
 class SourceWarper {
  public:
@@ -316,28 +200,25 @@ class SourceWarper {
       : source_(source), s_(setup), vtx_(vertices), options_(options), raster_(raster),
         width_(setup.src.width), height_(setup.src.height) {}
 
-    // Vertices next to a dropped triangle or on the source border are splatted afterwards:
-  // the mesh stops at the last sample centre, half a pixel short of where the pixel ends.
-  void Mesh(std::vector<uint8_t>* edge_scratch) {
+  // Blocks of kMaxBlock x kMaxBlock source pixels whose quads all join one surface are drawn
+  // as one quad (a plane is exact under perspective, a curved surface within a small fraction
+  // of a pixel), others split in four down to single quads: most of the image costs one
+  // quad setup per 16 source pixels. Vertices next to a dropped triangle or on the source
+  // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
+  // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
+  // source's stride.
+  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch) {
     const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
-    std::vector<uint8_t>& edge = *edge_scratch;
-    edge.assign(count, 0);
-    for (int y = 0; y + 1 < height_; ++y) {
-      for (int x = 0; x + 1 < width_; ++x) {
-        const size_t i00 = Index(x, y), i10 = i00 + 1;
-        const size_t i01 = i00 + static_cast<size_t>(width_), i11 = i01 + 1;
-        if (!ContinuousQuad(i00, i10, i01, i11)) {
-          Triangle(i00, i10, i01, &edge);
-          Triangle(i10, i11, i01, &edge);
-          continue;
-        }
-        raster_->SurfaceQuad(CornerAt(i00), CornerAt(i10), CornerAt(i01), CornerAt(i11));
-      }
+    continuous_ = continuous.data();
+    edge_ = edge_scratch;
+    edge_->assign(count, 0);
+    for (int y = 0; y + 1 < height_; y += kMaxBlock) {
+      for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
     }
     for (int y = 0; y < height_; ++y) {
       for (int x = 0; x < width_; ++x) {
         const bool border = x == 0 || y == 0 || x + 1 == width_ || y + 1 == height_;
-        if (border || edge[Index(x, y)] != 0) SplatVertex(x, y);
+        if (border || (*edge_)[Index(x, y)] != 0) SplatVertex(x, y);
       }
     }
   }
@@ -355,8 +236,77 @@ class SourceWarper {
   float SourceDepth(size_t i) const { return source_.depth.Values()[i]; }
 
   Corner CornerAt(size_t i) const {
+    const size_t w = static_cast<size_t>(width_);
     return {vtx_.u[i], vtx_.v[i], vtx_.inv_z[i], vtx_.angle[i],
-            source_.color.Pixels().data() + 3 * i};
+            source_.color.Pixels().data() + 3 * i, static_cast<float>(i % w),
+            static_cast<float>(i / w)};
+  }
+
+  static constexpr int kMaxBlock = 4;
+  // Relative inverse-depth deviation from the corners' blend within which a block is flat:
+  // its samples land within ~kFlatTolerance x (disparity in pixels) of where they should.
+  static constexpr float kFlatTolerance = 1e-3f;
+
+  // kSurface when every quad of the side x side block at (x, y) (inside the image) is one
+  // continuous surface and, for side > 1, the block is flat: a plane's inverse depth is
+  // affine in the image, so the samples' must match the bilinear blend of the corners' (a
+  // crease, such as a box's edge, would be cut off by the block's two triangles); tested at
+  // the centre and the edge midpoints. kSky when
+  // every quad is background. Else kInvalid.
+  uint8_t BlockKind(int x, int y, int side) const {
+    if (x + side >= width_ || y + side >= height_) return kInvalid;
+    const uint8_t kind = continuous_[Index(x, y)];
+    if (kind == kInvalid) return kInvalid;
+    for (int r = y; r < y + side; ++r) {
+      const uint8_t* row = continuous_ + Index(x, r);
+      for (int c = 0; c < side; ++c) {
+        if (row[c] != kind) return kInvalid;
+      }
+    }
+    if (side == 1 || kind == kSky) return kind;
+    const float* inv = vtx_.source_inv_depth.get();
+    const float i00 = inv[Index(x, y)], i10 = inv[Index(x + side, y)];
+    const float i01 = inv[Index(x, y + side)], i11 = inv[Index(x + side, y + side)];
+    // The centre and the edge midpoints: where a crease through the block shows most.
+    const int half = side / 2;
+    const float mid_top = 0.5f * (i00 + i10), mid_bottom = 0.5f * (i01 + i11);
+    const float mid_left = 0.5f * (i00 + i01), mid_right = 0.5f * (i10 + i11);
+    const float centre = 0.5f * (mid_top + mid_bottom);
+    const auto off = [&](int dx, int dy, float expected) {
+      return std::abs(inv[Index(x + dx, y + dy)] - expected) > kFlatTolerance * expected;
+    };
+    if (off(half, half, centre) || off(half, 0, mid_top) || off(half, side, mid_bottom) ||
+        off(0, half, mid_left) || off(side, half, mid_right)) {
+      return kInvalid;
+    }
+    return kind;
+  }
+
+  void Block(int x, int y, int side) {
+    if (x + 1 >= width_ || y + 1 >= height_) return;
+    const uint8_t kind = BlockKind(x, y, side);
+    if (kind != kInvalid) {
+      const Corner a = CornerAt(Index(x, y)), b = CornerAt(Index(x + side, y));
+      const Corner c = CornerAt(Index(x, y + side)), d = CornerAt(Index(x + side, y + side));
+      if (kind == kSurface) {
+        raster_->SurfaceBlock(a, b, c, d, static_cast<float>(side));
+      } else {
+        raster_->TexturedQuad<true>(a, b, c, d, static_cast<float>(side));
+      }
+      return;
+    }
+    if (side > 1) {
+      const int half = side / 2;
+      Block(x, y, half);
+      Block(x + half, y, half);
+      Block(x, y + half, half);
+      Block(x + half, y + half, half);
+      return;
+    }
+    const size_t i00 = Index(x, y), i10 = i00 + 1;
+    const size_t i01 = i00 + static_cast<size_t>(width_), i11 = i01 + 1;
+    Triangle(i00, i10, i01, edge_);
+    Triangle(i10, i11, i01, edge_);
   }
 
   // Two samples of one surface (or both background).
@@ -365,14 +315,6 @@ class SourceWarper {
     if (vtx_.kind[i] == kSky) return true;
     const float a = SourceDepth(i), b = SourceDepth(j);
     return std::max(a, b) <= s_.max_depth_ratio * std::min(a, b);
-  }
-
-  // The common case: four samples of one surface.
-  bool ContinuousQuad(size_t a, size_t b, size_t c, size_t d) const {
-    if ((vtx_.kind[a] & vtx_.kind[b] & vtx_.kind[c] & vtx_.kind[d]) != kSurface) return false;
-    const float da = SourceDepth(a), db = SourceDepth(b), dc = SourceDepth(c), dd = SourceDepth(d);
-    return std::max(std::max(da, db), std::max(dc, dd)) <=
-           s_.max_depth_ratio * std::min(std::min(da, db), std::min(dc, dd));
   }
 
   void Triangle(size_t a, size_t b, size_t c, std::vector<uint8_t>* edge) {
@@ -434,6 +376,8 @@ class SourceWarper {
   Rasterizer* raster_;
   int width_;
   int height_;
+  const uint8_t* continuous_ = nullptr;
+  std::vector<uint8_t>* edge_ = nullptr;
 };
 
 template <typename T>
@@ -475,8 +419,9 @@ WarpScratch::WarpScratch() : data_(std::make_unique<Data>()) {}
 WarpScratch::~WarpScratch() = default;
 WarpScratch::WarpScratch(WarpScratch&&) noexcept = default;
 WarpScratch& WarpScratch::operator=(WarpScratch&&) noexcept = default;
+const std::vector<uint8_t>& WarpScratch::Background() const { return data_->background; }
 
-void ForwardWarp(const SourceView& source, int source_index, const PosedCamera& target,
+void ForwardWarp(const SourceView& source, const PosedCamera& target,
                  const ForwardWarpOptions& options, WarpBuffer* buffer, WarpScratch* scratch) {
   options.Check();
   CheckSourceView(source);
@@ -502,21 +447,29 @@ void ForwardWarp(const SourceView& source, int source_index, const PosedCamera& 
     Allocate(&vertices.v, count);
     Allocate(&vertices.inv_z, count);
     Allocate(&vertices.angle, count);
+    Allocate(&vertices.source_inv_depth, count);
     Allocate(&vertices.kind, count);
     vertices.capacity = count;
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      ProjectRow(setup, source, data.background, data.ray_x, y, &vertices);
+      ProjectRow(setup, source, data.background.empty() ? nullptr : data.background.data(),
+                 data.ray_x.data(), y, &vertices);
     }
   });
 
   // Rasterisation of one source is serial: triangles from anywhere in the source can land on
   // any target pixel. Sources run in parallel into their own buffers (see Render).
-  Rasterizer raster(buffer, source_index);
+  Rasterizer raster(buffer, source.color);
   SourceWarper warper(source, setup, vertices, options, &raster);
   if (options.method == WarpMethod::kMesh) {
-    warper.Mesh(&data.edge);
+    data.continuous.resize(count);
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y < rows.end(); ++y) {
+        ContinuousRow(source, setup, vertices, y, data.continuous.data());
+      }
+    });
+    warper.Mesh(data.continuous, &data.edge);
   } else {
     warper.Splats();
   }

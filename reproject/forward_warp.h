@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include "reproject/view.h"
 
@@ -11,7 +12,9 @@ namespace parallax {
 
 enum class WarpMethod {
   kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
-  kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct.
+  kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct; flat
+           // 4x4 or 2x2 blocks of one surface (or of background) as one quad, the colour
+           // sampled bilinearly from the source at the interpolated source position.
 };
 
 struct ForwardWarpOptions {
@@ -38,8 +41,8 @@ struct ForwardWarpOptions {
 
 // What the blend weighs a sample by. Plain data, deliberately without initialisers: buffers
 // of them are allocated without being cleared (only written where a sample lands).
+// (The source is the buffer's: one buffer per source.)
 struct WarpWeight {
-  int32_t source;       // Index of the source in the render's list.
   float ray_angle_rad;  // Angle at the 3D point between the rays from the source and the
                         // target centres, as the chord 2 sin(angle / 2) (within 1% below 28
                         // degrees; 0 for background, whose rays are parallel).
@@ -62,6 +65,7 @@ class WarpBuffer {
   size_t Size() const { return static_cast<size_t>(width_) * static_cast<size_t>(height_); }
   // Target z-depth of the sample, 0 where nothing landed, kBackground for background.
   float Depth(size_t i) const { return depth_[i]; }
+  const float* Depths() const { return depth_.get(); }  // Size() of them.
   // Linear RGB of the sample; meaningful only where Depth(i) != 0.
   const float* Color(size_t i) const { return &color_[3 * i]; }
   // Meaningful only where Depth(i) != 0.
@@ -91,6 +95,9 @@ class WarpScratch {
 
   struct Data;  // Defined in forward_warp.cc.
   Data& Get() { return *data_; }
+  // MarkBackground of the last warped source's depth; empty when it did not use background
+  // at infinity.
+  const std::vector<uint8_t>& Background() const;
 
  private:
   std::unique_ptr<Data> data_;
@@ -98,11 +105,12 @@ class WarpScratch {
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see
-// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). Per-pixel work
-// is parallel (TBB) and allocation-free. Throws std::invalid_argument for a non-pinhole
+// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). Projection is
+// parallel over rows (TBB), rasterisation serial (Render warps sources in parallel); both are
+// allocation-free with a reused `scratch`. Throws std::invalid_argument for a non-pinhole
 // camera, mismatched sizes (CheckSourceView) or bad options.
 // `scratch` may be null (then the warp allocates its own).
-void ForwardWarp(const SourceView& source, int source_index, const PosedCamera& target,
+void ForwardWarp(const SourceView& source, const PosedCamera& target,
                  const ForwardWarpOptions& options, WarpBuffer* buffer,
                  WarpScratch* scratch = nullptr);
 

@@ -28,20 +28,21 @@ struct DepthRange {
   bool HasSurface() const { return near <= far; }
 };
 
-// One source as the frustum test sees it: the target ray at depth z lands at
+// One source as the classification sees it: the target ray at depth z lands at
 // point(z) = origin + z * R * ray_in_target, in the source frame.
 struct SourceFrustum {
   Pinhole pinhole;
   Eigen::Matrix3d rotation;  // source_from_target.
   Eigen::Vector3d origin;    // Target centre in the source frame.
+  const DepthMap* depth = nullptr;
+  const uint8_t* background = nullptr;  // Null: no background.
 };
 
-// Whether some z in [near, far] (far may be infinite; near == far == inf tests the
-// direction) puts the point inside the source image and in front of it. Each constraint is
-// c . point(z) >= 0, linear in z.
-bool SegmentInFrustum(const SourceFrustum& s, const Eigen::Vector3d& ray, double near,
-                      double far) {
-  const Eigen::Vector3d dir = s.rotation * ray;
+// The sub-interval of [near, far] (far may be infinite; near == far == inf tests the
+// direction) whose points lie inside the source image and in front of it, or false. Each
+// constraint is c . point(z) >= 0, linear in z.
+bool SegmentInFrustum(const SourceFrustum& s, const Eigen::Vector3d& dir, double near,
+                      double far, double* lo_out = nullptr, double* hi_out = nullptr) {
   const double w = s.pinhole.width, h = s.pinhole.height;
   const std::array<Eigen::Vector3d, 5> constraints = {
       Eigen::Vector3d(0, 0, 1),
@@ -61,7 +62,64 @@ bool SegmentInFrustum(const SourceFrustum& s, const Eigen::Vector3d& ray, double
     }
     if (!(lo <= hi)) return false;
   }
+  if (lo_out != nullptr) *lo_out = lo;
+  if (hi_out != nullptr) *hi_out = hi;
   return true;
+}
+
+enum class PointView { kOutside, kFree, kHidden, kUnknown };
+
+// What source `s` knows of the point at inverse depth `inv_depth` (0: the direction) on the
+// target ray whose source-frame direction is `dir`: outside its image, empty space (its depth
+// there is larger, or background), hidden (its depth is not larger), or unknown (depth 0 that
+// is not background: the source saw something there, at a depth nobody knows).
+PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir, double inv_depth,
+                      double tolerance) {
+  // The point scaled by inv_depth: the same pixel, and z / depth = p.z().
+  const Eigen::Vector3d p = s.origin * inv_depth + dir;
+  if (!(p.z() > 0)) return PointView::kOutside;
+  const double u = s.pinhole.fx * p.x() / p.z() + s.pinhole.cx;
+  const double v = s.pinhole.fy * p.y() / p.z() + s.pinhole.cy;
+  if (!(u >= 0 && v >= 0 && u < s.pinhole.width && v < s.pinhole.height)) {
+    return PointView::kOutside;
+  }
+  const int x = static_cast<int>(u), y = static_cast<int>(v);
+  const size_t i = static_cast<size_t>(y) * static_cast<size_t>(s.pinhole.width) +
+                   static_cast<size_t>(x);
+  if (s.background != nullptr && s.background[i] != 0) return PointView::kFree;
+  const double depth = s.depth->Values()[i];
+  if (depth == 0) return PointView::kUnknown;
+  // depth > z * (1 + tolerance) with z = p.z() / inv_depth; at infinity nothing finite is
+  // farther.
+  return depth * inv_depth > p.z() * (1 + tolerance) ? PointView::kFree : PointView::kHidden;
+}
+
+// Whether the ray is a hole between inverse depths inv_near >= inv_far: a sampled point
+// inside some source and seen as empty space by none (the ray reaches something hidden)
+// beyond a point some source sees as empty space (the ray passed into the sources' view in
+// the open), or a point some source saw without knowing its depth. A ray whose first points in any view are already hidden runs under a surface no
+// source saw, from outside every view: the ground below the sources' frames, not a hole.
+// Sampling starts at half the near depth, so a surface at the near end counts.
+bool RayIsHole(const std::vector<SourceFrustum>& sources, const std::vector<Eigen::Vector3d>& dirs,
+               double inv_near, double inv_far, const HoleOptions& options) {
+  const int samples = inv_near > inv_far ? options.free_space_samples : 1;
+  const double inv_start = samples == 1 ? inv_near : 2 * inv_near;
+  bool passed_free = samples == 1;
+  for (int k = 0; k < samples; ++k) {
+    const double inv_depth =
+        samples == 1 ? inv_far : inv_start + (inv_far - inv_start) * k / (samples - 1);
+    bool inside = false, free = false, unknown = false;
+    for (size_t j = 0; j < sources.size() && !free; ++j) {
+      const PointView view = ViewOfPoint(sources[j], dirs[j], inv_depth,
+                                         options.free_space_tolerance);
+      inside = inside || view != PointView::kOutside;
+      free = view == PointView::kFree;
+      unknown = unknown || view == PointView::kUnknown;
+    }
+    if (free) passed_free = true;
+    if (inside && !free && (passed_free || unknown) && inv_depth <= inv_near) return true;
+  }
+  return false;
 }
 
 std::vector<DepthRange> RowDepthRanges(const BlendResult& blend) {
@@ -129,9 +187,24 @@ void HoleOptions::Check() const {
     throw std::invalid_argument("HoleOptions.depth_range_rows = " +
                                 std::to_string(depth_range_rows) + ": expected >= 0");
   }
+  if (free_space_samples < 2 || free_space_samples > 1024) {
+    throw std::invalid_argument("HoleOptions.free_space_samples = " +
+                                std::to_string(free_space_samples) + ": expected [2, 1024]");
+  }
+  if (!(free_space_tolerance > 0 && free_space_tolerance < 1)) {
+    throw std::invalid_argument("HoleOptions.free_space_tolerance = " +
+                                std::to_string(free_space_tolerance) + ": expected (0, 1)");
+  }
 }
 
 ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>& sources,
+                        const PosedCamera& target, const HoleOptions& options) {
+  std::vector<ClassifySource> frustums;
+  for (const PosedCamera& source : sources) frustums.push_back({source, nullptr, nullptr});
+  return ClassifyPixels(blend, frustums, target, options);
+}
+
+ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,
                         const PosedCamera& target, const HoleOptions& options) {
   options.Check();
   const Pinhole pinhole = Pinhole::From(target.camera);
@@ -143,11 +216,29 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
                                 "x" + std::to_string(height));
   }
   std::vector<SourceFrustum> frustums;
-  for (const PosedCamera& source : sources) {
-    const Rigid3d source_from_target = RelativePose(target.cam_from_world, source.cam_from_world);
-    frustums.push_back({Pinhole::From(source.camera),
-                        source_from_target.rotation.toRotationMatrix(),
-                        source_from_target.translation});
+  bool all_depth = !sources.empty();
+  for (size_t j = 0; j < sources.size(); ++j) {
+    const ClassifySource& source = sources[j];
+    const Rigid3d source_from_target =
+        RelativePose(target.cam_from_world, source.camera.cam_from_world);
+    SourceFrustum frustum{Pinhole::From(source.camera.camera),
+                          source_from_target.rotation.toRotationMatrix(),
+                          source_from_target.translation, source.depth, nullptr};
+    const size_t count = static_cast<size_t>(frustum.pinhole.width) *
+                         static_cast<size_t>(frustum.pinhole.height);
+    if (source.depth != nullptr &&
+        (source.depth->Width() != frustum.pinhole.width ||
+         source.depth->Height() != frustum.pinhole.height ||
+         (source.background != nullptr && !source.background->empty() &&
+          source.background->size() != count))) {
+      throw std::invalid_argument("ClassifyPixels: source " + std::to_string(j) +
+                                  ": depth map or background mask does not match its camera");
+    }
+    if (source.background != nullptr && !source.background->empty()) {
+      frustum.background = source.background->data();
+    }
+    all_depth = all_depth && source.depth != nullptr;
+    frustums.push_back(frustum);
   }
   const std::vector<DepthRange> rows = RowDepthRanges(blend);
   DepthRange global;
@@ -165,6 +256,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
     // No surface anywhere: only the direction (infinite depth) can be tested.
     const double near = range.HasSurface() ? range.near : kInf;
     const double far = range.background || !range.HasSurface() ? kInf : range.far;
+    std::vector<Eigen::Vector3d> dirs(frustums.size());
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
       const SampleKind kind = blend.kind[i];
@@ -178,9 +270,20 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
       }
       const Eigen::Vector3d ray((x + 0.5 - pinhole.cx) / pinhole.fx,
                                 (y + 0.5 - pinhole.cy) / pinhole.fy, 1.0);
-      const bool in_view = std::any_of(frustums.begin(), frustums.end(), [&](const SourceFrustum& s) {
-        return SegmentInFrustum(s, ray, near, far);
-      });
+      // The span of depths some source's frustum holds (inverse depths, nearest first).
+      double inv_near = 0, inv_far = kInf;
+      bool in_view = false;
+      for (size_t j = 0; j < frustums.size(); ++j) {
+        dirs[j] = frustums[j].rotation * ray;
+        double lo = 0, hi = 0;
+        if (!SegmentInFrustum(frustums[j], dirs[j], near, far, &lo, &hi)) continue;
+        in_view = true;
+        inv_near = std::max(inv_near, 1 / lo);
+        inv_far = std::min(inv_far, std::isinf(hi) ? 0.0 : 1 / hi);
+      }
+      if (in_view && all_depth) {
+        in_view = RayIsHole(frustums, dirs, inv_near, inv_far, options);
+      }
       map.classes[i] = in_view ? PixelClass::kDisocclusion : PixelClass::kOutOfView;
       hole[i] = in_view ? 1 : 0;
     }

@@ -12,9 +12,11 @@ namespace parallax {
 enum class PixelClass : uint8_t {
   kCovered,       // A surface sample landed.
   kBackground,    // Only background-at-infinity samples landed (sky).
-  kOutOfView,     // The pixel's ray, over the scene's depth range, is outside every source.
+  kOutOfView,     // Nothing any source saw lies on the pixel's ray (over the scene's depth
+                  // range, each point is outside every source or seen as empty space).
   kCrack,         // A thin hole (see HoleOptions::crack_opening_px) inside some source's view.
-  kDisocclusion,  // A wider hole: surface hidden from every source.
+  kDisocclusion,  // A wider hole: the ray reaches a point some source contains but every
+                  // source that contains it sees something in front of it (or has no depth).
 };
 
 inline bool IsHole(PixelClass c) { return c == PixelClass::kCrack || c == PixelClass::kDisocclusion; }
@@ -26,6 +28,12 @@ struct HoleOptions {
   // The out-of-view test takes the scene's depth range from the covered pixels this many rows
   // above and below the pixel (the whole image where those rows have none); >= 0.
   int depth_range_rows = 2;
+  // Free-space test: points sampled on the pixel's ray over that depth range, uniformly in
+  // inverse depth (the last at infinity when the range reaches it); in [2, 1024].
+  int free_space_samples = 48;
+  // A source sees a point as empty space when its depth there exceeds the point's depth in
+  // that source by more than this share (or it sees background at infinity); in (0, 1).
+  double free_space_tolerance = 0.02;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
@@ -52,13 +60,32 @@ struct HoleMetrics {
   int largest_hole_px = 0;  // Pixels in the largest of them.
 };
 
-// Classifies the pixels of a blend into `target` from `sources`.
-// Out of view: a pixel without samples whose ray segment between the nearest and farthest
-// covered depth of nearby rows (to infinity where nearby rows hold background) lies outside
-// every source's frustum. The test is exact, not sampled: the segment projects into a source
-// image where four linear inequalities in the depth (plus z > 0) hold, so it is an interval
-// intersection per source. Throws std::invalid_argument for a non-pinhole camera, a size
-// mismatch between blend and target, or bad options.
+// A source as the classification sees it.
+struct ClassifySource {
+  PosedCamera camera;
+  // Its depth map (camera size); null: only its frustum is known (no free-space test).
+  const DepthMap* depth = nullptr;
+  // MarkBackground of `depth` (background at infinity, seen as empty space at every depth);
+  // null or empty: every depth-0 pixel is unknown.
+  const std::vector<uint8_t>* background = nullptr;
+};
+
+// Classifies the pixels of a blend into `target` from `sources`. A pixel without samples is
+// tested along its ray segment between the nearest and farthest covered depth of nearby rows
+// (to infinity where nearby rows hold background):
+//  - where the segment lies outside every source's frustum it is out of view. This part is
+//    exact: the segment projects into a source image where four linear inequalities in the
+//    depth (plus z > 0) hold, an interval intersection per source;
+//  - else, for sources with depth, free_space_samples points on it are looked up in the
+//    sources' depth maps: when every point is outside all sources or seen as empty space by
+//    one of them, no source saw anything on the ray, so it is out of view too (a target
+//    looking above the sources sees sky nobody photographed, not a hole);
+//  - else it is a hole: a crack when thin, else a disocclusion.
+// Throws std::invalid_argument for a non-pinhole camera, a size mismatch between blend and
+// target or between a source's camera and its depth map, or bad options.
+ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,
+                        const PosedCamera& target, const HoleOptions& options);
+// Frustums only: every ray segment inside some source's frustum is a hole.
 ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>& sources,
                         const PosedCamera& target, const HoleOptions& options);
 

@@ -36,13 +36,11 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
   const Clock::time_point start = Clock::now();
   const RenderOptions& options = options_;
   if (sources.empty()) throw std::invalid_argument("Render: no source views");
-  std::vector<PosedCamera> cameras;
   for (size_t i = 0; i < sources.size(); ++i) {
     if (sources[i] == nullptr) {
       throw std::invalid_argument("Render: source " + std::to_string(i) + " is null");
     }
     CheckSourceView(*sources[i]);
-    cameras.push_back(sources[i]->Posed());
   }
   Pinhole::From(target.camera);  // Rejects a distorted target before any work.
 
@@ -50,7 +48,7 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
   buffers_.resize(sources.size());
   scratch_.resize(sources.size());
   tbb::parallel_for(size_t{0}, sources.size(), [&](size_t i) {
-    ForwardWarp(*sources[i], static_cast<int>(i), target, options.warp, &buffers_[i], &scratch_[i]);
+    ForwardWarp(*sources[i], target, options.warp, &buffers_[i], &scratch_[i]);
   });
   result.timings.warp_ms = MsSince(start);
 
@@ -59,7 +57,11 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
   result.timings.blend_ms = MsSince(step);
 
   step = Clock::now();
-  result.classes = ClassifyPixels(blend, cameras, target, options.holes);
+  std::vector<ClassifySource> classify_sources;
+  for (size_t i = 0; i < sources.size(); ++i) {
+    classify_sources.push_back({sources[i]->Posed(), &sources[i]->depth, &scratch_[i].Background()});
+  }
+  result.classes = ClassifyPixels(blend, classify_sources, target, options.holes);
   result.metrics = ComputeHoleMetrics(result.classes);
   result.timings.classify_ms = MsSince(step);
 

@@ -1,9 +1,11 @@
 #include "reproject/source_selection.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace parallax {
 namespace {
@@ -45,11 +47,20 @@ double EstimateSceneDepth(const std::vector<PosedCamera>& sources, const PosedCa
   return distances.empty() ? 1.0 : Median(distances);
 }
 
+// What one source sees of the target's sample points.
+struct SampleViews {
+  std::vector<uint8_t> seen;             // Per sample.
+  std::vector<float> quality;            // 1 / (1 + angle / angle_scale), 0 where unseen.
+  std::vector<Eigen::Vector3f> to_source;  // Unit direction from the point to the source.
+};
+
 SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, double scene_depth,
-                     const SourceSelectionOptions& options) {
+                     const SourceSelectionOptions& options, SampleViews* views) {
   const Pinhole t = Pinhole::From(target.camera);
   const Pinhole s = Pinhole::From(source.camera);
   const Rigid3d source_from_target = RelativePose(target.cam_from_world, source.cam_from_world);
+  const Eigen::Matrix3d target_from_source_rotation =
+      source_from_target.rotation.conjugate().toRotationMatrix();
   const Eigen::Vector3d target_center_in_source = source_from_target.translation;
   SourceScore score;
   int samples = 0, seen = 0;
@@ -58,6 +69,9 @@ SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, doubl
     for (int gy = 0; gy < options.grid_rows; ++gy) {
       for (int gx = 0; gx < options.grid_cols; ++gx) {
         ++samples;
+        views->seen.push_back(0);
+        views->quality.push_back(0);
+        views->to_source.push_back(Eigen::Vector3f::Zero());
         const double u = (gx + 0.5) * t.width / options.grid_cols;
         const double v = (gy + 0.5) * t.height / options.grid_rows;
         const Eigen::Vector3d in_target((u - t.cx) / t.fx * scene_depth * factor,
@@ -71,7 +85,12 @@ SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, doubl
         // Rays to the point from the source centre (origin here) and the target centre.
         const Eigen::Vector3d from_target = p - target_center_in_source;
         const double cos_angle = p.normalized().dot(from_target.normalized());
-        angle_sum += std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+        const double angle_deg = std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+        angle_sum += angle_deg;
+        views->seen.back() = 1;
+        views->quality.back() = static_cast<float>(1 / (1 + angle_deg / options.angle_scale_deg));
+        // In the target frame, so that directions of different sources compare.
+        views->to_source.back() = (target_from_source_rotation * -p.normalized()).cast<float>();
       }
     }
   }
@@ -79,6 +98,23 @@ SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, doubl
   score.mean_angle_deg = seen > 0 ? angle_sum / seen : 180;
   score.score = score.overlap / (1 + score.mean_angle_deg / options.angle_scale_deg);
   return score;
+}
+
+std::vector<SourceScore> ScoreAll(const std::vector<PosedCamera>& sources,
+                                  const PosedCamera& target,
+                                  const SourceSelectionOptions& options,
+                                  std::vector<SampleViews>* views) {
+  options.Check();
+  const double scene_depth =
+      options.scene_depth > 0 ? options.scene_depth : EstimateSceneDepth(sources, target);
+  std::vector<SourceScore> scores;
+  views->assign(sources.size(), {});
+  for (size_t i = 0; i < sources.size(); ++i) {
+    SourceScore score = ScoreOne(sources[i], target, scene_depth, options, &(*views)[i]);
+    score.index = static_cast<int>(i);
+    scores.push_back(score);
+  }
+  return scores;
 }
 
 }  // namespace
@@ -94,33 +130,58 @@ void SourceSelectionOptions::Check() const {
   if (grid_rows < 1) fail("grid_rows", grid_rows, ">= 1");
   if (!(min_overlap > 0 && min_overlap <= 1)) fail("min_overlap", min_overlap, "(0, 1]");
   if (!(angle_scale_deg > 0 && std::isfinite(angle_scale_deg))) fail("angle_scale_deg", angle_scale_deg, "> 0");
+  if (!(diversity_angle_deg >= 0 && diversity_angle_deg <= 180)) {
+    fail("diversity_angle_deg", diversity_angle_deg, "[0, 180]");
+  }
 }
 
 std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
                                       const PosedCamera& target,
                                       const SourceSelectionOptions& options) {
-  options.Check();
-  const double scene_depth =
-      options.scene_depth > 0 ? options.scene_depth : EstimateSceneDepth(sources, target);
-  std::vector<SourceScore> scores;
-  for (size_t i = 0; i < sources.size(); ++i) {
-    SourceScore score = ScoreOne(sources[i], target, scene_depth, options);
-    score.index = static_cast<int>(i);
-    scores.push_back(score);
-  }
-  return scores;
+  std::vector<SampleViews> views;
+  return ScoreAll(sources, target, options, &views);
 }
 
 std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
                                const SourceSelectionOptions& options) {
-  std::vector<SourceScore> scores = ScoreSources(sources, target, options);
-  std::erase_if(scores, [&](const SourceScore& s) { return s.overlap < options.min_overlap; });
-  std::stable_sort(scores.begin(), scores.end(),
-                   [](const SourceScore& a, const SourceScore& b) { return a.score > b.score; });
-  std::vector<int> chosen;
+  std::vector<SampleViews> views;
+  const std::vector<SourceScore> scores = ScoreAll(sources, target, options, &views);
+  std::vector<int> candidates;
   for (const SourceScore& score : scores) {
-    if (static_cast<int>(chosen.size()) == options.num_sources) break;
-    chosen.push_back(score.index);
+    if (score.overlap >= options.min_overlap) candidates.push_back(score.index);
+  }
+  const size_t samples = views.empty() ? 0 : views.front().seen.size();
+  // Per sample, how much of it the chosen sources already see from each direction: the
+  // largest similarity exp(-(angle / diversity_angle)^2) to the chosen sources' rays.
+  const double sigma_rad = options.diversity_angle_deg * kPi / 180;
+  std::vector<int> chosen;
+  while (static_cast<int>(chosen.size()) < options.num_sources && !candidates.empty()) {
+    double best_gain = -1;
+    size_t best = 0;
+    for (size_t c = 0; c < candidates.size(); ++c) {
+      const SampleViews& view = views[static_cast<size_t>(candidates[c])];
+      double gain = 0;
+      for (size_t p = 0; p < samples; ++p) {
+        if (view.seen[p] == 0) continue;
+        double covered = 0;
+        for (int other : chosen) {
+          const SampleViews& o = views[static_cast<size_t>(other)];
+          if (o.seen[p] == 0 || sigma_rad <= 0) continue;
+          const double angle = std::acos(std::clamp(
+              static_cast<double>(view.to_source[p].dot(o.to_source[p])), -1.0, 1.0));
+          covered = std::max(covered, std::exp(-(angle / sigma_rad) * (angle / sigma_rad)));
+        }
+        gain += static_cast<double>(view.quality[p]) * (1 - covered);
+      }
+      // Ties (and diversity 0, where every gain is the plain score) keep the score order.
+      const double key = sigma_rad > 0 ? gain : scores[static_cast<size_t>(candidates[c])].score;
+      if (key > best_gain) {
+        best_gain = key;
+        best = c;
+      }
+    }
+    chosen.push_back(candidates[best]);
+    candidates.erase(candidates.begin() + static_cast<std::ptrdiff_t>(best));
   }
   return chosen;
 }

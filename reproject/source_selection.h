@@ -21,6 +21,11 @@ struct SourceSelectionOptions {
   // The score overlap / (1 + mean_angle / angle_scale_deg) halves at this mean angle between
   // source and target rays at the samples (degrees, > 0).
   double angle_scale_deg = 10;
+  // Diversity: a target sample that a chosen source already sees from a direction within
+  // about this angle (degrees; similarity exp(-(angle / diversity_angle_deg)^2)) gains little
+  // from another source seeing it from there, so later picks favour other directions and
+  // see behind what the first ones' views hide. 0: plain score order. In [0, 180].
+  double diversity_angle_deg = 10;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
@@ -37,10 +42,12 @@ std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
                                       const PosedCamera& target,
                                       const SourceSelectionOptions& options);
 
-// Indices of up to num_sources sources with the best scores, best first: large overlap with
-// the target's view of the scene, small angles between their rays and the target's. Sources
-// with overlap below min_overlap (behind the target's scene, looking elsewhere) are never
-// returned, so fewer may come back. Throws std::invalid_argument for a non-pinhole camera or
+// Indices of up to num_sources sources, chosen greedily, best first: the first has the best
+// score (large overlap with the target's view of the scene, small angles between its rays and
+// the target's); each next one adds the most sum over the target's samples it sees of
+// 1 / (1 + angle / angle_scale_deg) times how differently from the chosen ones it sees them
+// (diversity_angle_deg). Sources with overlap below min_overlap (behind the target's scene,
+// looking elsewhere) are never returned, so fewer may come back. Throws std::invalid_argument for a non-pinhole camera or
 // bad options.
 std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
                                const SourceSelectionOptions& options);

@@ -34,7 +34,7 @@ TEST(ForwardWarp, IdentityPoseReproducesSourceForBothMethods) {
     ForwardWarpOptions options;
     options.method = method;
     WarpBuffer buffer;
-    ForwardWarp(source, 0, camera, options, &buffer);
+    ForwardWarp(source, camera, options, &buffer);
     double max_color_error = 0, max_depth_error = 0;
     for (int y = 0; y < 120; ++y) {
       for (int x = 0; x < 160; ++x) {
@@ -61,7 +61,7 @@ TEST(ForwardWarp, MeshDropsTrianglesAcrossDepthDiscontinuities) {
   ForwardWarpOptions options;
   options.method = WarpMethod::kMesh;
   WarpBuffer buffer;
-  ForwardWarp(source, 0, target, options, &buffer);
+  ForwardWarp(source, target, options, &buffer);
   int intermediate = 0, surface = 0;
   for (size_t i = 0; i < buffer.Size(); ++i) {
     const float z = buffer.Depth(i);
@@ -84,7 +84,7 @@ TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
     ForwardWarpOptions options;
     options.method = method;
     WarpBuffer buffer;
-    ForwardWarp(source, 0, target, options, &buffer);
+    ForwardWarp(source, target, options, &buffer);
     for (size_t i = 0; i < buffer.Size(); ++i) {
       const float z = buffer.Depth(i);
       ASSERT_TRUE(z == 0 || (z > 0 && std::isfinite(z))) << z;
@@ -185,7 +185,7 @@ TEST(ForwardWarp, RejectsDistortedCamerasAndBadOptions) {
   source.camera.model = CameraModel::kSimpleRadial;
   source.camera.params = {150, 80, 60, 0.1};
   WarpBuffer buffer;
-  EXPECT_THROW(ForwardWarp(source, 0, CameraAt(TestCamera(), {0, 0, 0}), {}, &buffer),
+  EXPECT_THROW(ForwardWarp(source, CameraAt(TestCamera(), {0, 0, 0}), {}, &buffer),
                std::invalid_argument);
   ForwardWarpOptions options;
   options.max_slant_deg = 90;

@@ -141,6 +141,47 @@ TEST(Render, TwoSourcesOnEitherSideShrinkTheHoles) {
   }
 }
 
+// A target below the source and tilted up sees sky above the source's frame. At finite depth
+// its top rays pass inside the source's frustum, where the source saw sky (empty space): no
+// source saw anything there, so those pixels are out of view, not holes.
+TEST(Render, TargetLookingAboveTheSourcesSkyIsOutOfViewNotAHole) {
+  const Camera camera = MakePinholeCamera(1, 320, 240, 300, 300, 160, 120);
+  Scene scene;
+  // Ground 1.5 below the cameras (y points down), seen to 60 m; sky brighter upwards.
+  scene.planes.push_back({Eigen::Vector3d::UnitY(), 1.5, test::WavyTexture({0.4f, 0.35f, 0.3f}, 0.7)});
+  scene.boxes.push_back({{-1, -0.5, 6}, {1, 1.5, 7}, test::WavyTexture({0.6f, 0.3f, 0.2f}, 0.4)});
+  scene.sky = [](const Eigen::Vector3d& dir) {
+    const float k = static_cast<float>(0.6 - 0.4 * dir.y());
+    return Eigen::Vector3f(0.3f * k, 0.5f * k, 0.9f * k);
+  };
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  const double tilt = 15 * test::kPi / 180;
+  const PosedCamera target{camera, LookAt({0.3, 0.4, 0}, {0.3, 0.4 - 10 * std::tan(tilt), 10},
+                                          {0, -1, 0})};
+  // The frustum test alone (the former classification) calls the top rows holes.
+  RenderOptions options = Options(WarpMethod::kMesh);
+  const RenderResult result = Render({&source}, target, options);
+  const BlendResult blend = [&] {
+    WarpBuffer buffer;
+    ForwardWarp(source, target, options.warp, &buffer);
+    std::vector<WarpBuffer> buffers;
+    buffers.push_back(std::move(buffer));
+    return Blend(buffers, options.blend);
+  }();
+  const ClassMap frustum_only = ClassifyPixels(blend, {source.Posed()}, target, options.holes);
+  const HoleMetrics frustum_metrics = ComputeHoleMetrics(frustum_only);
+  EXPECT_GT(frustum_metrics.hole_ratio, 0.05);
+  // What is left is the ground the box hides (measured 1.1%).
+  EXPECT_LT(result.metrics.hole_ratio, 0.02);
+  EXPECT_LT(result.metrics.hole_ratio, 0.25 * frustum_metrics.hole_ratio);
+  EXPECT_GT(result.metrics.out_of_view_ratio, 0.05);
+  EXPECT_GT(result.metrics.background_ratio, 0.05);
+  for (int x = 0; x < 320; x += 8) EXPECT_EQ(result.classes.At(x, 0), PixelClass::kOutOfView) << x;
+  // The disocclusion beside the box stays a hole.
+  const RenderResult sideways = Render({&source}, CameraAt(camera, {0.8, 0, 0}), options);
+  EXPECT_GT(sideways.metrics.disocclusion_ratio, 0.005);
+}
+
 void ExpectFinite(const RenderResult& result) {
   for (float v : result.color.Pixels()) ASSERT_TRUE(std::isfinite(v));
   for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z) && z >= 0) << z;

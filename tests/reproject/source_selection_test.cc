@@ -43,6 +43,19 @@ TEST(SelectSources, NeverReturnsSourcesThatCannotContribute) {
   EXPECT_GT(scores[2].score, scores[0].score);
 }
 
+TEST(SelectSources, DiversityPrefersANewDirectionOverANearDuplicate) {
+  // Two sources 0.5 degrees apart next to the target, a third 25 degrees away on the other side.
+  const std::vector<PosedCamera> sources = {RingCamera(10), RingCamera(10.5), RingCamera(-25)};
+  SourceSelectionOptions options;
+  options.num_sources = 2;
+  options.diversity_angle_deg = 0;
+  EXPECT_EQ(SelectSources(sources, RingCamera(0), options), std::vector<int>({0, 1}));
+  options.diversity_angle_deg = 10;
+  EXPECT_EQ(SelectSources(sources, RingCamera(0), options), std::vector<int>({0, 2}));
+  options.diversity_angle_deg = -1;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
 TEST(SelectSources, RejectsBadOptions) {
   SourceSelectionOptions options;
   options.num_sources = 0;

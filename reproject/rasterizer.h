@@ -1,0 +1,462 @@
+#pragma once
+// The rasteriser behind ForwardWarp (internal to reproject/: included by forward_warp.cc
+// only): triangles, textured blocks and splats of one source written into its WarpBuffer
+// with a z-test.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <utility>
+
+#include "core/image.h"
+#include "reproject/forward_warp.h"
+
+namespace parallax::warp_internal {
+
+constexpr float kFloatMax = std::numeric_limits<float>::max();
+inline bool Finite(float value) { return std::abs(value) <= kFloatMax; }
+
+// floor and ceil for values >= -1 by truncation: std::floor is a library call without SSE4.1,
+// and these run several times per triangle.
+inline int FloorClamped(float value) { return static_cast<int>(value + 1.0f) - 1; }
+inline int CeilClamped(float value) {
+  const int floor = FloorClamped(value);
+  return static_cast<float>(floor) < value ? floor + 1 : floor;
+}
+
+// A vertex as the rasteriser reads it.
+struct Corner {
+  float u, v, inv_z, angle;
+  const float* rgb;
+  float sx, sy;  // Source pixel (column, row) whose centre this is.
+};
+
+// One triangle of a textured block: barycentric weights as affine functions of the pixel
+// centre, relative to the first corner (small numbers, so float keeps them exact to ~1e-6 of
+// the block), and per-corner attributes (times 1 / z for surfaces: those are affine in the
+// image).
+struct TriangleSetup {
+  float origin_u = 0, origin_v = 0;
+  // w0 = 1 + w0_du * du + w0_dv * dv; w1 likewise from 0.
+  float w0_du = 0, w0_dv = 0, w1_du = 0, w1_dv = 0;
+  float inv_z[3] = {}, sx[3] = {}, sy[3] = {}, angle[3] = {};
+  float stretch = 0;
+
+  // False for a degenerate triangle.
+  template <bool kBackground>
+  bool Init(const Corner& a, const Corner& b, const Corner& c, float source_area2) {
+    const float bu = b.u - a.u, bv = b.v - a.v, cu = c.u - a.u, cv = c.v - a.v;
+    const float area2 = bu * cv - bv * cu;
+    if (!(std::abs(area2) > 1e-12f) || !Finite(area2)) return false;
+    const float inv_area = 1.0f / area2;
+    origin_u = a.u;
+    origin_v = a.v;
+    w0_du = (bv - cv) * inv_area;
+    w0_dv = (cu - bu) * inv_area;
+    w1_du = cv * inv_area;
+    w1_dv = -cu * inv_area;
+    stretch = std::abs(area2) / source_area2;
+    const Corner* corners[3] = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+      const float scale = kBackground ? 1.0f : corners[k]->inv_z;
+      inv_z[k] = corners[k]->inv_z;
+      sx[k] = corners[k]->sx * scale;
+      sy[k] = corners[k]->sy * scale;
+      angle[k] = corners[k]->angle * scale;
+    }
+    return true;
+  }
+
+  // Barycentric weights of the pixel centre; false outside. Edges are inclusive with a hair
+  // of slack, so no centre on a shared edge falls between two triangles.
+  bool Inside(float pu, float pv, float w[3]) const {
+    constexpr float kSlack = -1e-5f;
+    const float du = pu - origin_u, dv = pv - origin_v;
+    w[0] = 1.0f + w0_du * du + w0_dv * dv;
+    w[1] = w1_du * du + w1_dv * dv;
+    w[2] = 1.0f - w[0] - w[1];
+    return w[0] >= kSlack && w[1] >= kSlack && w[2] >= kSlack;
+  }
+
+  static float Attribute(const float values[3], const float w[3]) {
+    return w[0] * values[0] + w[1] * values[1] + w[2] * values[2];
+  }
+};
+
+// An attribute affine in the image: value + du * d_u + dv * d_v, with du, dv relative to an
+// origin near the triangle.
+struct Plane {
+  float value = 0, d_u = 0, d_v = 0;
+  float At(float du, float dv) const { return value + du * d_u + dv * d_v; }
+};
+
+// A triangle's attributes over z (TriangleSetup) as planes about (origin_u, origin_v).
+struct AttributePlanes {
+  Plane inv_z, sx, sy, angle;
+  float stretch = 0;
+
+  AttributePlanes(const TriangleSetup& t, float origin_u, float origin_v) : stretch(t.stretch) {
+    // The barycentric weights as planes about the new origin.
+    const float ou = origin_u - t.origin_u, ov = origin_v - t.origin_v;
+    const Plane w0{1.0f + t.w0_du * ou + t.w0_dv * ov, t.w0_du, t.w0_dv};
+    const Plane w1{t.w1_du * ou + t.w1_dv * ov, t.w1_du, t.w1_dv};
+    const auto plane = [&](const float f[3]) {
+      // f0 w0 + f1 w1 + f2 (1 - w0 - w1).
+      return Plane{f[2] + (f[0] - f[2]) * w0.value + (f[1] - f[2]) * w1.value,
+                   (f[0] - f[2]) * w0.d_u + (f[1] - f[2]) * w1.d_u,
+                   (f[0] - f[2]) * w0.d_v + (f[1] - f[2]) * w1.d_v};
+    };
+    inv_z = plane(t.inv_z);
+    sx = plane(t.sx);
+    sy = plane(t.sy);
+    angle = plane(t.angle);
+  }
+};
+
+// Writes samples of one source into the target buffer (z-test: nearest surface wins;
+// background only where nothing is).
+class Rasterizer {
+ public:
+  Rasterizer(WarpBuffer* buffer, const Image& texture)
+      : width_(buffer->Width()),
+        height_(buffer->Height()),
+        depth_(buffer->MutableDepth()),
+        color_(buffer->MutableColor()),
+        weight_(buffer->MutableWeight()),
+        texture_(texture.Pixels().data()),
+        texture_width_(texture.Width()),
+        texture_height_(texture.Height()) {}
+
+  // Perspective-correct: inverse depth is affine in the image, attributes / z too.
+  void SurfaceTriangle(const Corner& a, const Corner& b, const Corner& c) {
+    Box box;
+    float inv_area;
+    if (!Setup(a, b, c, &box, &inv_area)) return;
+    const float stretch = Stretch(inv_area);
+    for (int y = box.y0; y <= box.y1; ++y) {
+      for (int x = box.x0; x <= box.x1; ++x) ShadeSurface(a, b, c, x, y, inv_area, stretch);
+    }
+  }
+
+  // A surface block as TexturedQuad<false> draws it, for the common convex quad: each pixel
+  // row's span is found from the quad's edges and walked with the attributes (inverse depth,
+  // source position and angle over z) stepped along x, so no pixel of the bounding box is
+  // tested against the triangles. A centre on an edge shared with the next block is drawn
+  // by both (edges are evaluated from the same corners in the same order), so no centre
+  // falls between blocks. Folded quads take TexturedQuad.
+  void SurfaceBlock(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
+                    float side) {
+    // Perimeter a, b, d, c: convex when the four turns agree.
+    const Corner* ring[4] = {&a, &b, &d, &c};
+    float turn[4];
+    for (int k = 0; k < 4; ++k) {
+      const Corner& p = *ring[k];
+      const Corner& q = *ring[(k + 1) % 4];
+      const Corner& r = *ring[(k + 2) % 4];
+      turn[k] = (q.u - p.u) * (r.v - q.v) - (q.v - p.v) * (r.u - q.u);
+    }
+    const bool convex = (turn[0] > 0 && turn[1] > 0 && turn[2] > 0 && turn[3] > 0) ||
+                        (turn[0] < 0 && turn[1] < 0 && turn[2] < 0 && turn[3] < 0);
+    if (!convex) {
+      TexturedQuad<false>(a, b, c, d, side);
+      return;
+    }
+    Box box;
+    if (!Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
+              std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
+              std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
+              std::max(std::max(a.v, b.v), std::max(c.v, d.v)), &box)) {
+      return;
+    }
+    const float source_area2 = side * side;
+    TriangleSetup first, second;
+    if (!first.Init<false>(a, b, c, source_area2) || !second.Init<false>(b, d, c, source_area2)) {
+      TexturedQuad<false>(a, b, c, d, side);
+      return;
+    }
+    const AttributePlanes planes[2] = {AttributePlanes(first, a.u, a.v),
+                                       AttributePlanes(second, a.u, a.v)};
+    // Side of the diagonal b-c: a's side is the first triangle.
+    const float diag_u = c.u - b.u, diag_v = c.v - b.v;
+    const float a_side = diag_u * (a.v - b.v) - diag_v * (a.u - b.u);
+    // Each edge from its upper corner (smaller v, then smaller u) down, so a shared edge
+    // gives the same crossings in both blocks; u at a row is top.u + (v - top.v) * slope.
+    struct Edge {
+      float top_u, top_v, bottom_v, slope, u_min, u_max;
+    };
+    Edge edges[4];
+    for (int k = 0; k < 4; ++k) {
+      const Corner* p = ring[k];
+      const Corner* q = ring[(k + 1) % 4];
+      if (q->v < p->v || (q->v == p->v && q->u < p->u)) std::swap(p, q);
+      const float dv = q->v - p->v;
+      edges[k] = {p->u, p->v, q->v, dv > 0 ? (q->u - p->u) / dv : 0.0f, std::min(p->u, q->u),
+                  std::max(p->u, q->u)};
+    }
+    for (int y = box.y0; y <= box.y1; ++y) {
+      const float pv = static_cast<float>(y) + 0.5f;
+      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+      for (const Edge& e : edges) {
+        if (!(pv >= e.top_v && pv <= e.bottom_v)) continue;
+        // Horizontal edges (bottom_v == top_v) span their whole length.
+        const float u = e.bottom_v > e.top_v ? e.top_u + (pv - e.top_v) * e.slope : e.u_min;
+        const float u_far = e.bottom_v > e.top_v ? u : e.u_max;
+        lo = std::min(lo, u);
+        hi = std::max(hi, u_far);
+      }
+      if (!(lo <= hi)) continue;
+      Box span;
+      if (!Clip(lo, hi, pv, pv, &span)) continue;
+      const float dv = pv - a.v;
+      for (int x = span.x0; x <= span.x1; ++x) {
+        const float pu = static_cast<float>(x) + 0.5f;
+        const float side_of = diag_u * (pv - b.v) - diag_v * (pu - b.u);
+        const AttributePlanes& t = planes[(side_of > 0) == (a_side > 0) ? 0 : 1];
+        const float du = pu - a.u;
+        const float inv_z = t.inv_z.At(du, dv);
+        if (!(inv_z > 0)) continue;
+        const float z = 1.0f / inv_z;
+        const size_t i = Index(x, y);
+        if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
+        WriteSample(i, z, t.sx.At(du, dv) * z, t.sy.At(du, dv) * z, t.angle.At(du, dv) * z,
+                    t.stretch);
+      }
+    }
+  }
+
+  // Triangles (a, b, c) and (b, d, c) of a square block of `side` x `side` source pixels of one
+  // continuous surface (or of background, kBackground), its colour sampled bilinearly from
+  // the source at the interpolated source position (so a block larger than one pixel keeps
+  // the texture's detail). Surfaces are perspective-correct, background screen-affine.
+  template <bool kBackground>
+  void TexturedQuad(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
+                    float side) {
+    Box box;
+    if (!Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
+              std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
+              std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
+              std::max(std::max(a.v, b.v), std::max(c.v, d.v)), &box)) {
+      return;
+    }
+    // Source triangles have area side^2 / 2: the area ratio is |area2| / side^2.
+    const float source_area2 = side * side;
+    TriangleSetup first, second;
+    const bool valid_1 = first.Init<kBackground>(a, b, c, source_area2);
+    const bool valid_2 = second.Init<kBackground>(b, d, c, source_area2);
+    for (int y = box.y0; y <= box.y1; ++y) {
+      const float pv = static_cast<float>(y) + 0.5f;
+      for (int x = box.x0; x <= box.x1; ++x) {
+        const float pu = static_cast<float>(x) + 0.5f;
+        float w[3];
+        const TriangleSetup* t = nullptr;
+        if (valid_1 && first.Inside(pu, pv, w)) {
+          t = &first;
+        } else if (valid_2 && second.Inside(pu, pv, w)) {
+          t = &second;
+        } else {
+          continue;
+        }
+        const size_t i = Index(x, y);
+        if constexpr (kBackground) {
+          if (depth_[i] != 0) continue;
+          WriteSample(i, WarpBuffer::kBackground, t->Attribute(t->sx, w),
+                      t->Attribute(t->sy, w), 0.0f, t->stretch);
+        } else {
+          const float inv_z = t->Attribute(t->inv_z, w);
+          if (!(inv_z > 0)) continue;
+          const float z = 1.0f / inv_z;
+          if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
+          WriteSample(i, z, t->Attribute(t->sx, w) * z, t->Attribute(t->sy, w) * z,
+                      t->Attribute(t->angle, w) * z, t->stretch);
+        }
+      }
+    }
+  }
+
+  // Directions: screen-affine interpolation (no depth); never covers a surface.
+  void BackgroundTriangle(const Corner& a, const Corner& b, const Corner& c) {
+    Box box;
+    float inv_area;
+    if (!Setup(a, b, c, &box, &inv_area)) return;
+    const float stretch = Stretch(inv_area);
+    for (int y = box.y0; y <= box.y1; ++y) {
+      const float pv = static_cast<float>(y) + 0.5f;
+      for (int x = box.x0; x <= box.x1; ++x) {
+        const float pu = static_cast<float>(x) + 0.5f;
+        float w[3];
+        if (!Barycentric(a, b, c, pu, pv, inv_area, w)) continue;
+        const size_t i = Index(x, y);
+        if (depth_[i] != 0) continue;
+        Write(i, WarpBuffer::kBackground, w, a, b, c, stretch);
+      }
+    }
+  }
+
+  // A square footprint of half-size (half_u, half_v) pixels around the corner.
+  void Splat(const Corner& a, float half_u, float half_v, float stretch, bool background) {
+    Box box;
+    if (!Clip(a.u - half_u, a.u + half_u, a.v - half_v, a.v + half_v, &box)) return;
+    const float z = background ? WarpBuffer::kBackground : 1.0f / a.inv_z;
+    if (!background && !Finite(z)) return;
+    const float q[3] = {1, 0, 0};
+    for (int y = box.y0; y <= box.y1; ++y) {
+      for (int x = box.x0; x <= box.x1; ++x) {
+        const size_t i = Index(x, y);
+        if (background ? depth_[i] != 0 : (depth_[i] != 0 && !(z < depth_[i]))) continue;
+        Write(i, z, q, a, a, a, stretch);
+      }
+    }
+  }
+
+ private:
+  struct Box {
+    int x0, x1, y0, y1;
+  };
+
+  // Twice the signed area of a triangle below which it is degenerate (pixels squared).
+  static constexpr float kMinArea2 = 1e-12f;
+
+  size_t Index(int x, int y) const {
+    return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
+  }
+
+  // Source triangles have area 1/2, so the area ratio is twice the target area: |area2|.
+  static float Stretch(float inv_area) { return std::abs(1.0f / inv_area); }
+
+  static float Area2(const Corner& a, const Corner& b, const Corner& c) {
+    return (b.u - a.u) * (c.v - a.v) - (b.v - a.v) * (c.u - a.u);
+  }
+
+  // Writes pixel (x, y) from the triangle when its centre lies inside and passes the z-test;
+  // returns whether the centre lies inside.
+  // `stretch` is the triangle's WarpWeight::stretch.
+  bool ShadeSurface(const Corner& a, const Corner& b, const Corner& c, int x, int y,
+                    float inv_area, float stretch) {
+    float w[3];
+    if (!Barycentric(a, b, c, static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f,
+                     inv_area, w)) {
+      return false;
+    }
+    const float inv_z = w[0] * a.inv_z + w[1] * b.inv_z + w[2] * c.inv_z;
+    if (!(inv_z > 0)) return true;
+    const float z = 1.0f / inv_z;
+    const size_t i = Index(x, y);
+    if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) return true;
+    const float q[3] = {w[0] * a.inv_z * z, w[1] * b.inv_z * z, w[2] * c.inv_z * z};
+    Write(i, z, q, a, b, c, stretch);
+    return true;
+  }
+
+  // Pixels whose centres lie in [u0, u1] x [v0, v1], clipped to the image. Coordinates are
+  // clamped as floats before the integer conversion so far-off vertices cannot overflow it.
+  bool Clip(float u0, float u1, float v0, float v1, Box* box) const {
+    const float w = static_cast<float>(width_), h = static_cast<float>(height_);
+    box->x0 = std::max(0, CeilClamped(std::clamp(u0 - 0.5f, -1.0f, w)));
+    box->x1 = std::min(width_ - 1, FloorClamped(std::clamp(u1 - 0.5f, -1.0f, w)));
+    box->y0 = std::max(0, CeilClamped(std::clamp(v0 - 0.5f, -1.0f, h)));
+    box->y1 = std::min(height_ - 1, FloorClamped(std::clamp(v1 - 0.5f, -1.0f, h)));
+    return box->x0 <= box->x1 && box->y0 <= box->y1;
+  }
+
+  bool Setup(const Corner& a, const Corner& b, const Corner& c, Box* box,
+             float* inv_area) const {
+    const float area2 = Area2(a, b, c);
+    if (!(std::abs(area2) > kMinArea2) || !Finite(area2)) return false;
+    if (!Clip(std::min({a.u, b.u, c.u}), std::max({a.u, b.u, c.u}),
+              std::min({a.v, b.v, c.v}), std::max({a.v, b.v, c.v}), box)) {
+      return false;
+    }
+    *inv_area = 1.0f / area2;
+    return true;
+  }
+
+  // Barycentric weights of the pixel centre; false outside the triangle. Edges are inclusive
+  // (with a hair of slack) so that no centre on a shared edge falls between two triangles.
+  static bool Barycentric(const Corner& a, const Corner& b, const Corner& c, float pu, float pv,
+                          float inv_area, float w[3]) {
+    constexpr float kSlack = -1e-5f;
+    w[0] = ((b.u - pu) * (c.v - pv) - (b.v - pv) * (c.u - pu)) * inv_area;
+    w[1] = ((c.u - pu) * (a.v - pv) - (c.v - pv) * (a.u - pu)) * inv_area;
+    w[2] = 1.0f - w[0] - w[1];
+    return w[0] >= kSlack && w[1] >= kSlack && w[2] >= kSlack;
+  }
+
+  void Write(size_t i, float depth, const float q[3], const Corner& a, const Corner& b,
+             const Corner& c, float stretch) {
+    depth_[i] = depth;
+    for (int k = 0; k < 3; ++k) color_[3 * i + k] = q[0] * a.rgb[k] + q[1] * b.rgb[k] + q[2] * c.rgb[k];
+    weight_[i] = WarpWeight{q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch};
+  }
+
+  // A sample whose colour is the source's, bilinear at source pixel (sx, sy).
+  void WriteSample(size_t i, float depth, float sx, float sy, float angle, float stretch) {
+    depth_[i] = depth;
+    weight_[i] = WarpWeight{angle, stretch};
+    if (stretch > kMagnifiedStretch && sx >= 1 && sy >= 1 &&
+        sx < static_cast<float>(texture_width_ - 2) && sy < static_cast<float>(texture_height_ - 2)) {
+      Bicubic(i, sx, sy);
+      return;
+    }
+    // Clamped to the image (the interpolation can overshoot a corner by a hair); then
+    // non-negative, so truncation is floor.
+    sx = std::clamp(sx, 0.0f, static_cast<float>(texture_width_ - 1));
+    sy = std::clamp(sy, 0.0f, static_cast<float>(texture_height_ - 1));
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+    const int x1 = std::min(x0 + 1, texture_width_ - 1), y1 = std::min(y0 + 1, texture_height_ - 1);
+    const float fx = sx - static_cast<float>(x0), fy = sy - static_cast<float>(y0);
+    const size_t row0 = static_cast<size_t>(y0) * static_cast<size_t>(texture_width_);
+    const size_t row1 = static_cast<size_t>(y1) * static_cast<size_t>(texture_width_);
+    const float* t00 = texture_ + 3 * (row0 + static_cast<size_t>(x0));
+    const float* t10 = texture_ + 3 * (row0 + static_cast<size_t>(x1));
+    const float* t01 = texture_ + 3 * (row1 + static_cast<size_t>(x0));
+    const float* t11 = texture_ + 3 * (row1 + static_cast<size_t>(x1));
+    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+    for (int k = 0; k < 3; ++k) {
+      color_[3 * i + k] = w00 * t00[k] + w10 * t10[k] + w01 * t01[k] + w11 * t11[k];
+    }
+  }
+
+  // Where the target samples the source more densely than its pixels (magnified), bilinear
+  // interpolation blurs the texture: Catmull-Rom over 4 x 4 source pixels keeps it sharper.
+  // Inside the image by at least one pixel (the caller checks).
+  void Bicubic(size_t i, float sx, float sy) {
+    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
+    float wx[4], wy[4];
+    CatmullRom(sx - static_cast<float>(x0), wx);
+    CatmullRom(sy - static_cast<float>(y0), wy);
+    float rgb[3] = {0, 0, 0};
+    for (int r = 0; r < 4; ++r) {
+      const float* row = texture_ + 3 * (static_cast<size_t>(y0 - 1 + r) * static_cast<size_t>(texture_width_) +
+                                         static_cast<size_t>(x0 - 1));
+      for (int c = 0; c < 4; ++c) {
+        const float w = wx[c] * wy[r];
+        for (int k = 0; k < 3; ++k) rgb[k] += w * row[3 * c + k];
+      }
+    }
+    // The kernel's negative lobes can undershoot below black.
+    for (int k = 0; k < 3; ++k) color_[3 * i + k] = std::max(rgb[k], 0.0f);
+  }
+
+  static void CatmullRom(float t, float w[4]) {
+    const float t2 = t * t, t3 = t2 * t;
+    w[0] = 0.5f * (-t3 + 2 * t2 - t);
+    w[1] = 0.5f * (3 * t3 - 5 * t2 + 2);
+    w[2] = 0.5f * (-3 * t3 + 4 * t2 + t);
+    w[3] = 0.5f * (t3 - t2);
+  }
+
+  // Target pixels per source pixel above which a sample is drawn bicubic.
+  static constexpr float kMagnifiedStretch = 1.5f;
+
+  int width_;
+  int height_;
+  float* depth_;
+  float* color_;
+  WarpWeight* weight_;
+  const float* texture_;
+  int texture_width_;
+  int texture_height_;
+};
+
+
+}  // namespace parallax::warp_internal
