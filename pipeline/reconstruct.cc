@@ -196,26 +196,62 @@ SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& 
   return aligned;
 }
 
+// What `colmap image_undistorter --output_type COLMAP` writes, for distortion-free cameras:
+// the photos as they are, the model with PINHOLE cameras, and the stereo/ folder layout with
+// the configuration files COLMAP's dense tools read.
+void CopyAsUndistorted(const SparseModel& model, const fs::path& photos_dir, const fs::path& output) {
+  fs::create_directories(output / "images");
+  fs::create_directories(output / "stereo" / "depth_maps");
+  fs::create_directories(output / "stereo" / "normal_maps");
+  fs::create_directories(output / "stereo" / "consistency_graphs");
+  SparseModel pinhole;
+  for (const Camera& camera : model.Cameras()) {
+    pinhole.AddCamera(MakePinholeCamera(camera.id, camera.width, camera.height, camera.FocalX(),
+                                        camera.FocalY(), camera.PrincipalX(), camera.PrincipalY()));
+  }
+  std::string patch_match, fusion;
+  for (const SparseImage& image : model.Images()) {
+    pinhole.AddImage(image);
+    fs::create_directories((output / "images" / image.name).parent_path());
+    fs::copy_file(photos_dir / image.name, output / "images" / image.name,
+                  fs::copy_options::overwrite_existing);
+    patch_match += image.name + "\n__auto__, 20\n";
+    fusion += image.name + "\n";
+  }
+  for (const Point3D& point : model.Points3D()) pinhole.AddPoint3D(point);
+  WriteSparseModel(pinhole, output / "sparse", SparseFormat::kBinary);
+  WriteFileAtomically(output / "stereo" / "patch-match.cfg", patch_match);
+  WriteFileAtomically(output / "stereo" / "fusion.cfg", fusion);
+}
+
 class StageRunner {
  public:
   StageRunner(const WorkspacePaths& paths, bool dry_run, ReconstructSummary& summary)
       : cache_(paths.Stages()), dry_run_(dry_run), summary_(summary) {}
 
   // Runs `body` unless the stage completed before with the same key and its output exists.
+  // A non-empty `not_needed` says why the stage's real work is not needed for this scene
+  // (`body` then does only the little that remains): the stage is reported as skipped, with
+  // that reason.
   void Run(const std::string& name, const std::string& key, const fs::path& output,
-           const std::function<void()>& body) {
+           const std::function<void()>& body, const std::string& not_needed = "") {
     StageRecord record{name, false, "", 0};
     if (cache_.IsDone(name, key) && fs::exists(output)) {
       record.skipped = true;
       record.reason = "inputs and options unchanged since the last run";
     } else if (dry_run_) {
-      record.reason = fs::exists(output) ? "inputs or options changed" : "not run yet";
+      record.skipped = !not_needed.empty();
+      record.reason = !not_needed.empty()  ? not_needed
+                      : fs::exists(output) ? "inputs or options changed"
+                                           : "not run yet";
     } else {
       const auto start = std::chrono::steady_clock::now();
       body();
       record.seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       cache_.MarkDone(name, key);
+      record.skipped = !not_needed.empty();
+      record.reason = not_needed;
     }
     summary_.stages.push_back(record);
   }
@@ -594,19 +630,32 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                         paths.Report().string());
   }
 
-  // Undistortion into the workspace layout (PINHOLE images and model).
-  stages.Run("undistort", undistort_key, paths.Sparse(), [&] {
-    const fs::path output = workspace / ".undistort.tmp";
-    RemoveAll(output);
-    colmap.Run("image_undistorter",
-               {"--image_path", photos_dir.string(), "--input_path", paths.RawModel().string(),
-                "--output_path", output.string(), "--output_type", "COLMAP"},
-               paths.Log("undistort"), "undistort", num_images, progress);
-    Replace(output / "images", paths.Images());
-    Replace(output / "stereo", workspace / "stereo");
-    Replace(output / "sparse", paths.Sparse());
-    RemoveAll(output);
-  });
+  // Undistortion into the workspace layout (PINHOLE images and model). Cameras without
+  // distortion need no resampling: the photos are copied as they are.
+  const bool distortion_free = std::none_of(raw_model.Cameras().begin(), raw_model.Cameras().end(),
+                                            [](const Camera& c) { return c.HasDistortion(); });
+  stages.Run(
+      "undistort", undistort_key, paths.Sparse(),
+      [&] {
+        const fs::path output = workspace / ".undistort.tmp";
+        RemoveAll(output);
+        if (distortion_free) {
+          CopyAsUndistorted(raw_model, photos_dir, output);
+        } else {
+          colmap.Run("image_undistorter",
+                     {"--image_path", photos_dir.string(), "--input_path",
+                      paths.RawModel().string(), "--output_path", output.string(),
+                      "--output_type", "COLMAP"},
+                     paths.Log("undistort"), "undistort", num_images, progress);
+        }
+        Replace(output / "images", paths.Images());
+        Replace(output / "stereo", workspace / "stereo");
+        Replace(output / "sparse", paths.Sparse());
+        RemoveAll(output);
+      },
+      distortion_free ? "the cameras have no lens distortion: photos copied, not resampled "
+                        "(colmap image_undistorter not needed)"
+                      : "");
   const SparseModel model = ReadSparseModel(paths.Sparse());
   FillModelStatistics(model, photos, summary);
 

@@ -1,6 +1,7 @@
 // End to end through the real colmap on example_images/small.
 #include "pipeline/reconstruct.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include <gtest/gtest.h>
@@ -91,6 +92,13 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
     EXPECT_LT((CameraCenter(found->cam_from_world) - CameraCenter(image.cam_from_world)).norm(), 1e-9);
   }
   EXPECT_DOUBLE_EQ(model.Cameras().front().FocalX(), truth.Cameras().front().FocalX());
+  // PINHOLE cameras: nothing to undistort, the photos are copied (and COLMAP's stereo_fusion
+  // below still accepts the workspace).
+  const auto undistort = std::find_if(summary.stages.begin(), summary.stages.end(),
+                                      [](const StageRecord& s) { return s.name == "undistort"; });
+  ASSERT_NE(undistort, summary.stages.end());
+  EXPECT_TRUE(undistort->skipped);
+  EXPECT_NE(undistort->reason.find("no lens distortion"), std::string::npos) << undistort->reason;
 
   // The stereo alone, in the true cameras (measured: within 2% 0.69, completeness 0.72).
   const SceneFolder scene{kSmall};
