@@ -20,11 +20,12 @@ std::string CsvRow(const std::string& name, const NovelView& view) {
   const HoleMetrics& m = view.result.metrics;
   std::string sources;
   for (const std::string& source : view.sources) sources += (sources.empty() ? "" : " ") + source;
+  const std::string fill = view.result.fill.skipped.empty() ? "ran" : "skipped: " + view.result.fill.skipped;
   char row[512];
-  std::snprintf(row, sizeof(row), "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%d,%.2f\n", name.c_str(),
+  std::snprintf(row, sizeof(row), "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%d,%s,%.2f\n", name.c_str(),
                 sources.c_str(), m.hole_ratio, view.result.fill.hole_ratio_filled, m.crack_ratio,
                 m.disocclusion_ratio, m.out_of_view_ratio, m.background_ratio, m.hole_count,
-                m.largest_hole_px, view.ms);
+                m.largest_hole_px, fill.c_str(), view.ms);
   return row;
 }
 
@@ -100,7 +101,7 @@ void RegisterRenderCommand(CLI::App& app) {
     }
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
-        "out_of_view_ratio,background_ratio,holes,largest_hole_px,ms\n";
+        "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
     double hole_sum = 0, filled_sum = 0, ms_sum = 0;
     for (size_t i = 0; i < targets.size(); ++i) {
       const NovelView view =

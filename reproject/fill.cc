@@ -181,9 +181,19 @@ FillSummary FillHoles(const ClassMap& classes, const FillOptions& options, Blend
                                 std::to_string(blend->color.Height()));
   }
   FillSummary summary;
-  if (options.method == FillMethod::kDepthAware) summary.filled_px = FillDepthAware(classes, options, blend);
-  if (options.method == FillMethod::kInpaint) summary.filled_px = FillInpaint(classes, options, blend);
   size_t empty = 0;
+  for (PixelClass c : classes.classes) {
+    const bool fillable = IsHole(c) || (options.fill_out_of_view && c == PixelClass::kOutOfView);
+    if (fillable) ++empty;
+  }
+  if (empty == 0) {
+    summary.skipped = "no holes to fill";
+  } else if (options.method == FillMethod::kDepthAware) {
+    summary.filled_px = FillDepthAware(classes, options, blend);
+  } else if (options.method == FillMethod::kInpaint) {
+    summary.filled_px = FillInpaint(classes, options, blend);
+  }
+  empty = 0;
   for (PixelClass c : classes.classes) {
     if (c != PixelClass::kCovered && c != PixelClass::kBackground) ++empty;
   }

@@ -1,5 +1,7 @@
 #pragma once
 // Hole filling after blending.
+#include <string>
+
 #include "reproject/blend.h"
 #include "reproject/holes.h"
 
@@ -31,6 +33,8 @@ struct FillSummary {
   // Share of all pixels still without colour after filling (holes nothing reached, and
   // out-of-view pixels when they are not filled). 0 when everything got a colour.
   double hole_ratio_filled = 0;
+  // Why filling was left out, when it was (nothing to fill); empty when it ran.
+  std::string skipped;
 };
 
 // Fills the pixels of `blend` where nothing landed (holes; out-of-view ones too with

@@ -90,7 +90,8 @@ class Renderer {
   // Draws one frame of the view's camera size into the internal framebuffer and, when
   // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer). The
   // shadow map is re-rendered only when the light, its size or the PCF bias changed (the scene
-  // is fixed): moving the eye costs the main pass alone.
+  // is fixed): moving the eye costs the main pass alone. Only Render fills the auxiliary
+  // target; Draw leaves it as it was.
   void Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer = -1);
 
   // Draws and reads the frame back.

@@ -15,12 +15,18 @@ out vec3 v_normal;
 out vec2 v_uv;
 out vec3 v_colour;
 out float v_eye_depth;
+// The shadow map's clip coordinates are linear in the position: interpolated, not computed per
+// pixel (the link drops them from programs without a shadow map).
+uniform mat4 u_shadow_from_world;
+out vec4 v_shadow_clip;
+invariant gl_Position;  // The depth pre-pass must produce the very same depths.
 void main() {
   v_world = a_position;
   v_normal = a_normal;
   v_uv = a_uv;
   v_colour = a_colour;
   v_eye_depth = (u_cam_from_world * vec4(a_position, 1.0)).z;
+  v_shadow_clip = u_shadow_from_world * vec4(a_position, 1.0);
   gl_PointSize = u_point_size;
   gl_Position = u_clip_from_world * vec4(a_position, 1.0);
 }
@@ -50,7 +56,7 @@ uniform float u_exposure;     // Linear scale, 2^stops.
 
 const int u_shadow_mode = SHADOW_MODE;      // 0 none, 1 planar (second pass), 2 map, 3 pcf
 uniform sampler2DShadow u_shadow_map;
-uniform mat4 u_shadow_from_world;
+in vec4 v_shadow_clip;
 uniform vec2 u_ndc_to_depth;  // window depth = ndc.z * x + y
 const int u_pcf_radius = PCF_RADIUS;
 uniform vec4 u_ground;        // Plane (n, d) for the planar shadow pass.
@@ -78,7 +84,7 @@ vec3 LinearToSrgb(vec3 c) {
 // 1 lit, 0 shadowed. Hardware comparison gives a bilinearly filtered 0/1 per tap; outside the
 // light's frustum the border depth 1 reads as lit.
 float ShadowVisibility() {
-  vec4 clip = u_shadow_from_world * vec4(v_world, 1.0);
+  vec4 clip = v_shadow_clip;
   if (clip.w <= 0.0) return 1.0;
   vec3 ndc = clip.xyz / clip.w;
   vec3 coord = vec3(ndc.xy * 0.5 + 0.5, ndc.z * u_ndc_to_depth.x + u_ndc_to_depth.y);
@@ -123,7 +129,14 @@ vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, 
 
 void main() {
   vec3 view_dir = normalize(u_eye - v_world);
+#if ALBEDO_SOURCE == 3
   vec3 n = length(v_normal) > 0.0 ? normalize(v_normal) : view_dir;
+#else
+  // The mesh is flat-shaded and its shaded pass shares vertices between faces: the face normal
+  // is the cross product of the position's screen derivatives (both lie in the plane).
+  vec3 n = cross(dFdx(v_world), dFdy(v_world));
+  n = dot(n, n) > 0.0 ? normalize(n) : view_dir;
+#endif
   // Windings of reconstructed meshes are not consistent: light the side the eye sees.
   if (dot(n, view_dir) < 0.0) n = -n;
 
@@ -150,7 +163,7 @@ void main() {
   vec3 albedo = vec3(0.7);
   bool relight = true;
   if (u_albedo_source == 0) {
-    albedo = SrgbToLinear(texture(u_atlas, v_uv).rgb);
+    albedo = texture(u_atlas, v_uv).rgb;  // An sRGB texture: sampling returns linear values.
   } else if (u_albedo_source == 3) {
     albedo = SrgbToLinear(v_colour);
   } else if (u_albedo_source == 1) {
@@ -162,7 +175,7 @@ void main() {
       albedo = sum.rgb / sum.w;
       relight = false;
     } else if (u_has_atlas) {
-      albedo = SrgbToLinear(texture(u_atlas, v_uv).rgb);  // No photo sees this surface.
+      albedo = texture(u_atlas, v_uv).rgb;  // No photo sees this surface.
     }
   }
 
@@ -182,6 +195,7 @@ const char* const kDepthVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 uniform mat4 u_clip_from_world;
 uniform float u_point_size;
+invariant gl_Position;  // Same depths as the surface shader's, for the pre-pass.
 void main() {
   gl_PointSize = u_point_size;
   gl_Position = u_clip_from_world * vec4(a_position, 1.0);

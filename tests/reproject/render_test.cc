@@ -82,6 +82,22 @@ TEST(Render, PlaneMovedSidewaysHasNoHolesAndAnOutOfViewStrip) {
   }
 }
 
+TEST(Render, FillingIsSkippedWhenNothingIsMissing) {
+  const Camera camera = MakePinholeCamera(1, 160, 120, 150, 150, 80, 60);
+  Scene scene;
+  scene.planes.push_back(test::WallAt(5, test::WavyTexture({0.45f, 0.4f, 0.35f}, 0.4)));
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  // The source's own camera: every pixel covered, nothing to fill.
+  const RenderResult same = Render({&source}, source.Posed(), Options(WarpMethod::kMesh));
+  EXPECT_EQ(same.metrics.hole_ratio + same.metrics.out_of_view_ratio, 0.0);
+  EXPECT_EQ(same.fill.skipped, "no holes to fill");
+  EXPECT_EQ(same.fill.filled_px, 0);
+  // Moved sideways: an out-of-view strip to fill, so filling runs.
+  const RenderResult moved = Render({&source}, CameraAt(camera, {0.3, 0, 0}), Options(WarpMethod::kMesh));
+  EXPECT_GT(moved.metrics.out_of_view_ratio, 0.05);
+  EXPECT_TRUE(moved.fill.skipped.empty());
+}
+
 TEST(Render, BoxInFrontOfWallDisocclusionMatchesRayCasting) {
   const Scene scene = BoxScene();
   const PosedCamera source_camera = CameraAt(BoxCamera(), {0, 0, 0});
