@@ -122,7 +122,7 @@ std::string PlotScript(const fs::path& out_dir, const std::vector<BenchStage>& s
   script << "set terminal pngcairo size 1400,420 font 'sans,10'\n"
          << "set output '" << (out_dir / "error_vs_time.png").string() << "'\n"
          << "set multiplot layout 1," << stages.size() << "\n"
-         << "set logscale x\nset grid\nset key below\nset offsets graph 0.05, graph 0.05, graph 0.08, graph 0.08\n"
+         << "set logscale x\nset grid\nset key top outside horizontal center\nset offsets graph 0.05, graph 0.05, graph 0.08, graph 0.08\n"
          << "set datafile separator '\\t'\n";
   for (const BenchStage& stage : stages) {
     const std::vector<const BenchRow*> rows_of_stage = Plottable(rows, stage);
