@@ -117,6 +117,7 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
     names.push_back(image.name);
   }
   SourceLibrary library(gt_sources ? scene.Training() : SourcePathsFor(workspace));
+  library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
   const std::filesystem::path comparison_dir =
       workspace / "evaluation" / (gt_sources ? "novel_gt_sources" : "novel");
   const NovelEvaluation result =

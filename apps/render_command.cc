@@ -99,6 +99,10 @@ void RegisterRenderCommand(CLI::App& app) {
     if (!std::filesystem::is_directory(arguments->input / "gt")) {
       EstimateMissingDepth(arguments->input, library, targets, selection);
     }
+    for (const std::string& name : library.DropViewsWithoutDepth()) {
+      std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
+                   name.c_str());
+    }
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
         "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";

@@ -183,6 +183,25 @@ const SourceView& SourceLibrary::Load(int index) {
   return *slot;
 }
 
+std::vector<std::string> SourceLibrary::DropViewsWithoutDepth() {
+  std::vector<std::string> dropped;
+  std::vector<PosedCamera> cameras;
+  std::vector<std::string> names;
+  for (size_t i = 0; i < cameras_.size(); ++i) {
+    if (fs::exists(paths_.DepthFor(names_[i]))) {
+      cameras.push_back(cameras_[i]);
+      names.push_back(names_[i]);
+    } else {
+      dropped.push_back(names_[i]);
+    }
+  }
+  cameras_ = std::move(cameras);
+  names_ = std::move(names);
+  loaded_.clear();
+  loaded_.resize(cameras_.size());
+  return dropped;
+}
+
 int SourceLibrary::LoadedCount() const {
   int count = 0;
   for (const auto& view : loaded_) count += view != nullptr;

@@ -44,6 +44,9 @@ class SourceLibrary {
   // Throws BadInputError naming the file for a missing or corrupt photo or depth map.
   const SourceView& Load(int index);
   int LoadedCount() const;
+  // Leaves out the views without a depth map on disk (their depth could not be estimated, e.g.
+  // no stereo partner); returns their names. Call before any Load.
+  std::vector<std::string> DropViewsWithoutDepth();
 
  private:
   ViewSetPaths paths_;
