@@ -162,12 +162,7 @@ class Rasterizer {
       return;
     }
     Box box;
-    if (!Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
-              std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
-              std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
-              std::max(std::max(a.v, b.v), std::max(c.v, d.v)), &box)) {
-      return;
-    }
+    if (!ClipQuad(a, b, c, d, &box)) return;
     const float source_area2 = side * side;
     TriangleSetup first, second;
     if (!first.Init<false>(a, b, c, source_area2) || !second.Init<false>(b, d, c, source_area2)) {
@@ -232,12 +227,7 @@ class Rasterizer {
   void TexturedQuad(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
                     float side) {
     Box box;
-    if (!Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
-              std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
-              std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
-              std::max(std::max(a.v, b.v), std::max(c.v, d.v)), &box)) {
-      return;
-    }
+    if (!ClipQuad(a, b, c, d, &box)) return;
     // Source triangles have area side^2 / 2: the area ratio is |area2| / side^2.
     const float source_area2 = side * side;
     TriangleSetup first, second;
@@ -345,6 +335,14 @@ class Rasterizer {
     const float q[3] = {w[0] * a.inv_z * z, w[1] * b.inv_z * z, w[2] * c.inv_z * z};
     Write(i, z, q, a, b, c, stretch);
     return true;
+  }
+
+  // The pixel box of a quad's bounding rectangle, clipped to the target; false when empty.
+  bool ClipQuad(const Corner& a, const Corner& b, const Corner& c, const Corner& d, Box* box) const {
+    return Clip(std::min(std::min(a.u, b.u), std::min(c.u, d.u)),
+                std::max(std::max(a.u, b.u), std::max(c.u, d.u)),
+                std::min(std::min(a.v, b.v), std::min(c.v, d.v)),
+                std::max(std::max(a.v, b.v), std::max(c.v, d.v)), box);
   }
 
   // Pixels whose centres lie in [u0, u1] x [v0, v1], clipped to the image. Coordinates are
