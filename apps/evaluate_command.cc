@@ -104,7 +104,7 @@ nlohmann::json EvaluateMesh(const std::filesystem::path& obj, const SparseModel&
 // images.
 nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::path& workspace,
                              bool gt_sources, const Similarity3d& truth_from_estimate,
-                             const RenderSettings& settings) {
+                             const NovelViewSettings& settings) {
   const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
   const Similarity3d estimate_from_truth =
       gt_sources ? Similarity3d{} : truth_from_estimate.Inverse();
@@ -155,7 +155,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     bool no_align = false;
     bool gt_sources = false;
     bool novel_only = false;
-    RenderSettings settings;
+    NovelViewSettings settings;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(

@@ -65,7 +65,7 @@ void RegisterRenderCommand(CLI::App& app) {
     std::filesystem::path cameras;
     std::string path;
     std::filesystem::path out;
-    RenderSettings settings;
+    NovelViewSettings settings;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(

@@ -4,7 +4,7 @@
 
 namespace parallax {
 
-void RenderSettings::Resolve() {
+void NovelViewSettings::Resolve() {
   ForwardWarpOptions& warp_options = render.warp;
   warp_options.method = warp == "splat" ? WarpMethod::kSplat : WarpMethod::kMesh;
   if (warp == "naive") {
@@ -15,7 +15,7 @@ void RenderSettings::Resolve() {
   }
 }
 
-void AddRenderOptions(CLI::App& command, RenderSettings& settings) {
+void AddRenderOptions(CLI::App& command, NovelViewSettings& settings) {
   command.add_option("--sources", settings.selection.num_sources,
                      "source views per novel view: the best K by overlap and angle (default 4)")
       ->check(CLI::Range(1, 64));

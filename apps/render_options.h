@@ -7,7 +7,7 @@
 
 namespace parallax {
 
-struct RenderSettings {
+struct NovelViewSettings {
   SourceSelectionOptions selection;
   RenderOptions render;
   // --warp naive: the baseline to beat, a nearest-pixel point warp of each source without
@@ -17,6 +17,6 @@ struct RenderSettings {
   void Resolve();
 };
 
-void AddRenderOptions(CLI::App& command, RenderSettings& settings);
+void AddRenderOptions(CLI::App& command, NovelViewSettings& settings);
 
 }  // namespace parallax

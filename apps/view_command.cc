@@ -36,7 +36,7 @@ struct ViewArguments {
   std::string point_light;      // "x,y,z" (world): a point light instead.
   ShadowMode shadows = ShadowMode::kPcf;
   TextureMode texture = TextureMode::kAtlas;
-  RenderSettings settings;
+  FrameSettings settings;
   bool no_cameras = false;
   bool no_grid = false;
   int timed_frames = 0;  // Extra frames drawn after the screenshot to time the renderer.
@@ -61,8 +61,8 @@ std::pair<int, int> ParseSize(const std::string& text) {
   return {width, height};
 }
 
-RenderSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
-  RenderSettings settings = a.settings;
+FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
+  FrameSettings settings = a.settings;
   settings.shadows = a.shadows;
   settings.texture = a.texture;
   settings.show_cameras = !a.no_cameras;
@@ -94,7 +94,7 @@ std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name
 
 // Draws `frames` more frames of the same view, each finished with glFinish, and prints the
 // median and the fastest: the frame time of the interactive viewer holding still.
-void PrintFrameTimes(Renderer& renderer, const ViewCamera& view, const RenderSettings& settings, int frames) {
+void PrintFrameTimes(SceneRenderer& renderer, const ViewCamera& view, const FrameSettings& settings, int frames) {
   std::vector<double> ms;
   for (int i = 0; i < frames; ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -107,7 +107,7 @@ void PrintFrameTimes(Renderer& renderer, const ViewCamera& view, const RenderSet
               static_cast<int>(view.camera.width), static_cast<int>(view.camera.height), ms[ms.size() / 2], ms[0]);
 }
 
-void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const RenderSettings& settings) {
+void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const FrameSettings& settings) {
   const std::optional<std::pair<int, int>> size =
       a.size.empty() ? std::nullopt : std::optional(ParseSize(a.size));
   ViewCamera view;
@@ -119,9 +119,9 @@ void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const Rend
     view = OrbitViewCamera(scene, a.orbit_deg.value_or(30), a.elevation_deg, width, height, a.fov_deg);
   }
   const HeadlessGlContext context;
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const auto start = std::chrono::steady_clock::now();
-  const RenderResult result = renderer.Render(view, settings);
+  const FrameResult result = renderer.Render(view, settings);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   for (const std::string& note : renderer.TakeNotes()) std::fprintf(stderr, "note: %s\n", note.c_str());
   WriteImage(a.screenshot, result.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
@@ -176,7 +176,7 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {
     const ViewerScene scene = LoadViewerScene(a->workspace);
-    const RenderSettings settings = Settings(*a, scene);
+    const FrameSettings settings = Settings(*a, scene);
     if (!a->screenshot.empty()) {
       TakeScreenshot(*a, scene, settings);
       return;

@@ -189,10 +189,10 @@ void AddLine(std::vector<Vertex>& lines, const Eigen::Vector3d& a, const Eigen::
 // Each source camera as a pyramid from its centre to its image corners at `depth`, with a
 // tick on the top edge so "up" is visible: kFrustumVertices line vertices per camera, in order.
 constexpr int kFrustumVertices = 18;
-std::vector<Vertex> FrustumLines(const std::vector<SourceView>& sources, double depth) {
+std::vector<Vertex> FrustumLines(const std::vector<ViewerSource>& sources, double depth) {
   std::vector<Vertex> lines;
   const Eigen::Vector3f colour(0.9f, 0.45f, 0.1f);
-  for (const SourceView& source : sources) {
+  for (const ViewerSource& source : sources) {
     const Rigid3d world_from_cam = source.cam_from_world.Inverse();
     const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
     const double w = static_cast<double>(source.camera.width), h = static_cast<double>(source.camera.height);
@@ -382,9 +382,9 @@ struct EyeTarget {
 
 }  // namespace
 
-void RenderSettings::Check() const {
+void FrameSettings::Check() const {
   const auto fail = [](const std::string& field, const std::string& value) {
-    throw std::invalid_argument("RenderSettings::" + field + " is out of range: " + value);
+    throw std::invalid_argument("FrameSettings::" + field + " is out of range: " + value);
   };
   if (shadow_map_size < 64 || shadow_map_size > 8192) fail("shadow_map_size (64..8192)", std::to_string(shadow_map_size));
   if (pcf_radius < 0 || pcf_radius > 4) fail("pcf_radius (0..4)", std::to_string(pcf_radius));
@@ -423,7 +423,7 @@ struct ShadowMapKey {
   }
 };
 
-struct Renderer::Impl {
+struct SceneRenderer::Impl {
   const ViewerScene& scene;
   bool reverse_z = false;  // glClipControl is available (and then always set to zero-to-one).
   GlProgram depth, planar, lines;
@@ -468,7 +468,7 @@ struct Renderer::Impl {
                : DirectionalLightMatrix(light.direction, scene.extent, scene.bounds, Range());
   }
   // What casts shadows and occludes projectors: the mesh when there is one, else the points.
-  void DrawCasters(const RenderSettings& settings, const GlProgram& program) {
+  void DrawCasters(const FrameSettings& settings, const GlProgram& program) {
     if (mesh.count > 0 && &program == &depth) {
       DrawMeshDepth();
     } else if (mesh.count > 0) {
@@ -499,20 +499,20 @@ struct Renderer::Impl {
     if (frusta.count > first) glDrawArrays(GL_LINES, first, frusta.count - first);
   }
   void RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
-                      const RenderSettings& settings, float slope_bias);
+                      const FrameSettings& settings, float slope_bias);
   GLuint Photo(int source);
-  int SetUpProjectors(const ViewCamera& view, const RenderSettings& settings);
+  int SetUpProjectors(const ViewCamera& view, const FrameSettings& settings);
   const GlProgram& SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius);
-  void UseSurfaceProgram(const GlProgram& program, const ViewCamera& view, const RenderSettings& settings,
+  void UseSurfaceProgram(const GlProgram& program, const ViewCamera& view, const FrameSettings& settings,
                          const Eigen::Matrix4f& clip_from_world, int projectors);
-  void DrawSurfaces(const ViewCamera& view, const RenderSettings& settings,
+  void DrawSurfaces(const ViewCamera& view, const FrameSettings& settings,
                     const Eigen::Matrix4f& clip_from_world, int shadow_mode, int projectors);
-  void DrawPlanarShadows(const ViewCamera& view, const RenderSettings& settings,
+  void DrawPlanarShadows(const ViewCamera& view, const FrameSettings& settings,
                          const Eigen::Matrix4f& clip_from_world, int projectors);
 };
 
-void Renderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
-                                    const RenderSettings& settings, float slope_bias) {
+void SceneRenderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
+                                    const FrameSettings& settings, float slope_bias) {
   glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.Get());
   glViewport(0, 0, target.width, target.height);
   glDisable(GL_STENCIL_TEST);
@@ -531,7 +531,7 @@ void Renderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& 
   glDisable(GL_POLYGON_OFFSET_FILL);
 }
 
-GLuint Renderer::Impl::Photo(int source) {
+GLuint SceneRenderer::Impl::Photo(int source) {
   auto found = photos.find(source);
   if (found == photos.end()) {
     found = photos.emplace(source, UploadSrgbTexture(ReadImage(scene.sources[source].image_path))).first;
@@ -540,11 +540,11 @@ GLuint Renderer::Impl::Photo(int source) {
 }
 
 // Renders each chosen source camera's depth map and binds its photo; returns how many.
-int Renderer::Impl::SetUpProjectors(const ViewCamera& view, const RenderSettings& settings) {
+int SceneRenderer::Impl::SetUpProjectors(const ViewCamera& view, const FrameSettings& settings) {
   const std::vector<int> chosen =
       NearestSourceViews(scene, CameraCenter(view.cam_from_world), settings.projective_views);
   for (size_t k = 0; k < chosen.size(); ++k) {
-    const SourceView& source = scene.sources[chosen[k]];
+    const ViewerSource& source = scene.sources[chosen[k]];
     const Eigen::Vector2d range = DepthBounds(scene.bounds, source.cam_from_world);
     const Eigen::Matrix4f clip_from_world =
         PerspectiveProjection(source.camera, range[0], range[1], Range()) * ViewMatrix(source.cam_from_world);
@@ -563,7 +563,7 @@ int Renderer::Impl::SetUpProjectors(const ViewCamera& view, const RenderSettings
   return static_cast<int>(chosen.size());
 }
 
-const GlProgram& Renderer::Impl::SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius) {
+const GlProgram& SceneRenderer::Impl::SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius) {
   if (shadow_mode != 3) pcf_radius = 0;
   auto found = surface_programs.find({albedo_source, shadow_mode, pcf_radius});
   if (found != surface_programs.end()) return found->second;
@@ -582,8 +582,8 @@ const GlProgram& Renderer::Impl::SurfaceProgram(int albedo_source, int shadow_mo
   return surface_programs.emplace(std::tuple{albedo_source, shadow_mode, pcf_radius}, std::move(program)).first->second;
 }
 
-void Renderer::Impl::UseSurfaceProgram(const GlProgram& program, const ViewCamera& view,
-                                       const RenderSettings& settings, const Eigen::Matrix4f& clip_from_world,
+void SceneRenderer::Impl::UseSurfaceProgram(const GlProgram& program, const ViewCamera& view,
+                                       const FrameSettings& settings, const Eigen::Matrix4f& clip_from_world,
                                        int projectors) {
   program.Use();
   program.Set("u_clip_from_world", clip_from_world);
@@ -610,7 +610,7 @@ void Renderer::Impl::UseSurfaceProgram(const GlProgram& program, const ViewCamer
   program.Set("u_point_size", settings.point_size_px);
 }
 
-void Renderer::Impl::DrawSurfaces(const ViewCamera& view, const RenderSettings& settings,
+void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettings& settings,
                                   const Eigen::Matrix4f& clip_from_world, int shadow_mode,
                                   int projectors) {
   const int albedo = settings.texture == TextureMode::kProjective ? 1
@@ -652,7 +652,7 @@ void Renderer::Impl::DrawSurfaces(const ViewCamera& view, const RenderSettings& 
 // Planar shadows: mark in the stencil the pixels covered by the geometry flattened onto the
 // ground along the light (each pixel once, however many casters overlap: no double darkening),
 // then redraw the ground there unlit.
-void Renderer::Impl::DrawPlanarShadows(const ViewCamera& view, const RenderSettings& settings,
+void SceneRenderer::Impl::DrawPlanarShadows(const ViewCamera& view, const FrameSettings& settings,
                                        const Eigen::Matrix4f& clip_from_world, int projectors) {
   const GroundPlane& ground = *scene.ground;
   const Eigen::Vector4f plane(static_cast<float>(ground.normal.x()), static_cast<float>(ground.normal.y()),
@@ -686,7 +686,7 @@ void Renderer::Impl::DrawPlanarShadows(const ViewCamera& view, const RenderSetti
   glDisable(GL_STENCIL_TEST);
 }
 
-Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
+SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
   Impl& r = *impl_;
   r.reverse_z = HasExtension("GL_ARB_clip_control");
   if (r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
@@ -700,7 +700,7 @@ Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scen
   }
   if (!scene.points.empty()) r.points = Upload(PointVertices(scene.points));
   r.frustum_depth = FrustumDepth(scene);
-  for (const SourceView& source : scene.sources) r.source_centres.push_back(CameraCenter(source.cam_from_world));
+  for (const ViewerSource& source : scene.sources) r.source_centres.push_back(CameraCenter(source.cam_from_world));
   if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, r.frustum_depth));
   r.grid = Upload(GridLines(scene));
   if (!scene.mesh.atlas.Empty()) r.atlas = UploadSrgbTexture(scene.mesh.atlas);
@@ -710,18 +710,18 @@ Renderer::Renderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scen
   r.shadow.Resize(1, 1);
   for (DepthTarget& target : r.projector_depth) target.Resize(1, 1);
   glEnable(GL_PROGRAM_POINT_SIZE);
-  CheckGlError("Renderer setup");
+  CheckGlError("SceneRenderer setup");
 }
 
-Renderer::~Renderer() = default;
+SceneRenderer::~SceneRenderer() = default;
 
-void Renderer::Finish() const { glFinish(); }
+void SceneRenderer::Finish() const { glFinish(); }
 
-bool Renderer::UsesReverseZ() const { return impl_->reverse_z; }
+bool SceneRenderer::UsesReverseZ() const { return impl_->reverse_z; }
 
-std::vector<std::string> Renderer::TakeNotes() { return std::exchange(impl_->notes, {}); }
+std::vector<std::string> SceneRenderer::TakeNotes() { return std::exchange(impl_->notes, {}); }
 
-void Renderer::Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer) {
+void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer) {
   settings.Check();
   Impl& r = *impl_;
   const bool reverse_z = r.reverse_z && settings.reverse_z;
@@ -814,10 +814,10 @@ void Renderer::Draw(const ViewCamera& view, const RenderSettings& settings, int 
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(window_framebuffer));
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
-  CheckGlError("Renderer::Draw");
+  CheckGlError("SceneRenderer::Draw");
 }
 
-RenderResult Renderer::Render(const ViewCamera& view, const RenderSettings& settings) {
+FrameResult SceneRenderer::Render(const ViewCamera& view, const FrameSettings& settings) {
   impl_->with_aux = true;
   try {
     Draw(view, settings);
@@ -835,8 +835,8 @@ RenderResult Renderer::Render(const ViewCamera& view, const RenderSettings& sett
   glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
   glReadBuffer(GL_COLOR_ATTACHMENT1);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aux.data());
-  CheckGlError("Renderer::Render read back");
-  RenderResult result{Image(width, height, 3), Image(width, height, 4)};
+  CheckGlError("SceneRenderer::Render read back");
+  FrameResult result{Image(width, height, 3), Image(width, height, 4)};
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
     for (int x = 0; x < width; ++x) {

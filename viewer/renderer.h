@@ -43,7 +43,7 @@ struct LightSettings {
   float intensity = 1;  // Irradiance (directional) or intensity (point, falls off as 1/d^2).
 };
 
-struct RenderSettings {
+struct FrameSettings {
   ShadowMode shadows = ShadowMode::kPcf;
   TextureMode texture = TextureMode::kAtlas;
   LightSettings light;
@@ -72,30 +72,30 @@ struct ViewCamera {
   double near = 0;  // Near plane (scene units); 0 fits it to the scene bounds.
 };
 
-struct RenderResult {
+struct FrameResult {
   Image colour;  // sRGB-encoded RGB, top row first.
   // Per pixel: light visibility in [0, 1] (1 lit; shadow map/PCF/planar), n.l (the normal
   // turned towards the eye), eye z-depth, coverage (1 where a surface was drawn).
   Image aux;
 };
 
-class Renderer {
+class SceneRenderer {
  public:
   // Uploads the scene. Throws std::runtime_error if a shader does not compile or GL fails.
-  explicit Renderer(const ViewerScene& scene);
-  ~Renderer();
-  Renderer(const Renderer&) = delete;
-  Renderer& operator=(const Renderer&) = delete;
+  explicit SceneRenderer(const ViewerScene& scene);
+  ~SceneRenderer();
+  SceneRenderer(const SceneRenderer&) = delete;
+  SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   // Draws one frame of the view's camera size into the internal framebuffer and, when
   // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer). The
   // shadow map is re-rendered only when the light, its size or the PCF bias changed (the scene
   // is fixed): moving the eye costs the main pass alone. Only Render fills the auxiliary
   // target; Draw leaves it as it was.
-  void Draw(const ViewCamera& view, const RenderSettings& settings, int window_framebuffer = -1);
+  void Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer = -1);
 
   // Draws and reads the frame back.
-  RenderResult Render(const ViewCamera& view, const RenderSettings& settings);
+  FrameResult Render(const ViewCamera& view, const FrameSettings& settings);
 
   // Waits until every GL command issued so far has finished (glFinish), e.g. to time a frame.
   void Finish() const;

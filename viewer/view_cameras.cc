@@ -10,7 +10,7 @@
 namespace parallax {
 
 ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
-  for (const SourceView& source : scene.sources) {
+  for (const ViewerSource& source : scene.sources) {
     if (source.name == name || std::filesystem::path(source.name).stem() == name) {
       Camera camera = MakePinholeCamera(source.camera.id, source.camera.width, source.camera.height,
                                         source.camera.FocalX(), source.camera.FocalY(),
@@ -60,7 +60,7 @@ ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, std::op
   return ViewCamera{camera, OrbitPose(orbit.target, scene.up, azimuth_deg, orbit.elevation_deg, orbit.distance), 0};
 }
 
-ViewCamera ScaledSourceViewCamera(const SourceView& source, int width, int height) {
+ViewCamera ScaledSourceViewCamera(const ViewerSource& source, int width, int height) {
   const double scale = static_cast<double>(width) / static_cast<double>(source.camera.width);
   const Camera camera = MakePinholeCamera(1, static_cast<uint64_t>(width), static_cast<uint64_t>(height),
                                           source.camera.FocalX() * scale, source.camera.FocalY() * scale,

@@ -37,6 +37,6 @@ ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, std::op
                            int width, int height, double fov_deg = 50);
 
 // A source camera's view scaled to `width` x `height` (same field of view horizontally).
-ViewCamera ScaledSourceViewCamera(const SourceView& source, int width, int height);
+ViewCamera ScaledSourceViewCamera(const ViewerSource& source, int width, int height);
 
 }  // namespace parallax

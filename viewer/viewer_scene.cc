@@ -28,9 +28,9 @@ size_t PlyTypeSize(const std::string& type) {
 
 // Mean "up" (-y) of the source cameras in world coordinates; nullopt without cameras or when
 // they disagree so much that the mean is meaningless.
-std::optional<Eigen::Vector3d> CamerasUp(const std::vector<SourceView>& sources) {
+std::optional<Eigen::Vector3d> CamerasUp(const std::vector<ViewerSource>& sources) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  for (const SourceView& source : sources) {
+  for (const ViewerSource& source : sources) {
     sum += source.cam_from_world.rotation.conjugate() * Eigen::Vector3d(0, -1, 0);
   }
   if (sources.empty() || sum.norm() < 0.3 * static_cast<double>(sources.size())) {
@@ -93,8 +93,8 @@ std::vector<Eigen::Vector3f> Subsample(const std::vector<ColouredPoint>& points,
   return positions;
 }
 
-std::vector<SourceView> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir) {
-  std::vector<SourceView> sources;
+std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir) {
+  std::vector<ViewerSource> sources;
   const SparseModel model = ReadSparseModel(sparse_dir);
   for (const SparseImage& image : model.Images()) {
     const Camera& camera = model.CameraById(image.camera_id);
@@ -160,7 +160,7 @@ std::vector<ColouredPoint> ReadColouredPly(const fs::path& path) {
   return points;
 }
 
-std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, const Eigen::Vector3d& up,
+std::optional<CameraRig> FitCameraRig(const std::vector<ViewerSource>& sources, const Eigen::Vector3d& up,
                                       const Eigen::AlignedBox3f& extent) {
   constexpr size_t kMinCameras = 3;
   if (sources.size() < kMinCameras || extent.isEmpty()) return std::nullopt;
@@ -168,7 +168,7 @@ std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, co
   // sum (I - d d^T) x = sum (I - d d^T) c.
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
-  for (const SourceView& source : sources) {
+  for (const ViewerSource& source : sources) {
     const Eigen::Vector3d d = source.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
     const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - d * d.transpose();
     a += across;
@@ -184,7 +184,7 @@ std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, co
   if (!rig.target.allFinite() || !near_extent.contains(rig.target.cast<float>())) return std::nullopt;
   std::vector<double> distances, elevations, half_width_tans;
   size_t in_front = 0;
-  for (const SourceView& source : sources) {
+  for (const ViewerSource& source : sources) {
     in_front += (source.cam_from_world * rig.target).z() > 0;
     const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - rig.target;
     distances.push_back(offset.norm());

@@ -20,7 +20,7 @@ namespace parallax {
 
 // A photo with the camera that took it (pinhole; distortion is ignored: workspaces hold
 // undistorted images).
-struct SourceView {
+struct ViewerSource {
   std::string name;  // Image file name as in the sparse model.
   Camera camera;
   Rigid3d cam_from_world;
@@ -45,7 +45,7 @@ struct CameraRig {
 struct ViewerScene {
   TexturedMesh mesh;                 // No triangles when the workspace has no mesh.
   std::vector<ColouredPoint> points; // Empty when the workspace has no fused.ply.
-  std::vector<SourceView> sources;
+  std::vector<ViewerSource> sources;
   Eigen::AlignedBox3f bounds;        // Exact bounds of the mesh and the points: for clipping.
   // Robust bounds (RobustBounds, 2% outliers a side) of what is shown: the mesh (area-weighted
   // samples) when there is one, else the points; merged with `focus`. Far outliers of a fused
@@ -86,7 +86,7 @@ std::vector<ColouredPoint> ReadColouredPly(const std::filesystem::path& path);
 // The rig of cameras looking in at a common point: nullopt with fewer than 3 cameras, when
 // their optical axes do not converge (e.g. a walk looking ahead), or when the point they
 // converge to is behind most of them or farther than half `extent`'s diagonal outside it. Pure.
-std::optional<CameraRig> FitCameraRig(const std::vector<SourceView>& sources, const Eigen::Vector3d& up,
+std::optional<CameraRig> FitCameraRig(const std::vector<ViewerSource>& sources, const Eigen::Vector3d& up,
                                       const Eigen::AlignedBox3f& extent);
 
 }  // namespace parallax

@@ -42,7 +42,7 @@ const char* TextureName(TextureMode mode) {
 // here and never throw.
 struct WindowState {
   const ViewerScene* scene = nullptr;
-  RenderSettings settings;
+  FrameSettings settings;
   double azimuth_deg = 30, elevation_deg = 25, distance = 1;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();
   Orbit home;  // Where R goes back to.
@@ -71,7 +71,7 @@ void UpdateLight(WindowState& s) {
 void OnKey(GLFWwindow* window, int key, int, int action, int) {
   if (action != GLFW_PRESS && action != GLFW_REPEAT) return;
   WindowState& s = *State(window);
-  RenderSettings& settings = s.settings;
+  FrameSettings& settings = s.settings;
   const int sources = static_cast<int>(s.scene->sources.size());
   switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
@@ -197,7 +197,7 @@ std::string ViewerKeyHelp() {
          "      N / B next / previous source camera   R reset view   Esc quit\n";
 }
 
-void RunViewerWindow(const ViewerScene& scene, RenderSettings settings, const WindowOptions& options,
+void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const WindowOptions& options,
                      std::optional<int> start_source, const std::function<void(const std::string&)>& log) {
   options.Check();
   settings.Check();
@@ -209,7 +209,7 @@ void RunViewerWindow(const ViewerScene& scene, RenderSettings settings, const Wi
   }
   GlfwWindow glfw(options.width, options.height);
   glfwSwapInterval(1);
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
 
   WindowState state;
   state.scene = &scene;

@@ -1,5 +1,5 @@
 #pragma once
-// The interactive viewer: a GLFW window drawing through the same Renderer as the offscreen
+// The interactive viewer: a GLFW window drawing through the same SceneRenderer as the offscreen
 // path, with a trackball (orbit, pan, zoom) and keys for every setting. Key help goes to
 // `log` (the terminal); the mode and the frame time go to the window title.
 #include <functional>
@@ -23,7 +23,7 @@ struct WindowOptions {
 // Runs until the window is closed or Esc is pressed. `start_source` jumps to that source
 // camera first (index into scene.sources). Throws ToolError when there is no display (the
 // message suggests --screenshot) or GLFW cannot open an OpenGL 3.3 core window.
-void RunViewerWindow(const ViewerScene& scene, RenderSettings settings, const WindowOptions& options,
+void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const WindowOptions& options,
                      std::optional<int> start_source,
                      const std::function<void(const std::string&)>& log);
 

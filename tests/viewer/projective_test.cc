@@ -40,15 +40,15 @@ TEST(ViewerProjective, ScreenshotFromASourceCameraReproducesItsPhoto) {
   const ViewerScene scene = SmallScene();
   ASSERT_TRUE(scene.ground.has_value());
   EXPECT_GT(scene.ground->normal.z(), 0.999) << "the ground of a z-up scene is horizontal";
-  Renderer renderer(scene);
-  RenderSettings settings;
+  SceneRenderer renderer(scene);
+  FrameSettings settings;
   settings.texture = TextureMode::kProjective;
   settings.shadows = ShadowMode::kNone;
   settings.show_cameras = false;
   settings.show_grid = false;
   for (const std::string name : {"0000", "0005.png"}) {
     const ViewCamera view = SourceViewCamera(scene, name);
-    const RenderResult result = renderer.Render(view, settings);
+    const FrameResult result = renderer.Render(view, settings);
     const Image photo = ReadImage(kSmall / "images" / (std::filesystem::path(name).stem().string() + ".png"));
     if (const char* dir = std::getenv("PARALLAX_VIEWER_TEST_OUT")) {
       fs::create_directories(dir);
@@ -140,12 +140,12 @@ TEST(ViewerScene, OrbitLooksWhereTheSourceCamerasLookFromAsFar) {
   const ViewerScene scene = SmallScene();
   ASSERT_TRUE(scene.rig.has_value()) << "the small scene's cameras stand on an arc looking in";
   // Every camera of the arc is 5.46 from its centre of interest.
-  for (const SourceView& source : scene.sources) {
+  for (const ViewerSource& source : scene.sources) {
     EXPECT_NEAR((CameraCenter(source.cam_from_world) - scene.rig->target).norm(), scene.rig->distance, 0.05);
   }
   // With the photos' own field of view, the default orbit at a camera's azimuth and elevation
   // stands where that camera stands.
-  const SourceView& source = scene.sources[4];
+  const ViewerSource& source = scene.sources[4];
   const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - scene.rig->target;
   const double azimuth_deg = std::atan2(offset.y(), offset.x()) * 180 / std::numbers::pi;
   const double fov_deg = 2 * std::atan(0.5 * static_cast<double>(source.camera.width) / source.camera.FocalX()) * 180 /
@@ -153,7 +153,7 @@ TEST(ViewerScene, OrbitLooksWhereTheSourceCamerasLookFromAsFar) {
   const ViewCamera view = OrbitViewCamera(scene, azimuth_deg, std::nullopt, 320, 240, fov_deg);
   EXPECT_LT((CameraCenter(view.cam_from_world) - CameraCenter(source.cam_from_world)).norm(), 0.1);
   // Cameras all looking ahead, as on a walk, make no rig.
-  std::vector<SourceView> walk;
+  std::vector<ViewerSource> walk;
   for (int i = 0; i < 10; ++i) {
     walk.push_back(scene.sources[0]);
     walk.back().cam_from_world = LookAt(Eigen::Vector3d(i, 0, 1), Eigen::Vector3d(i + 5, 0, 1), Eigen::Vector3d::UnitZ());
@@ -166,14 +166,14 @@ TEST(ViewerScene, OrbitLooksWhereTheSourceCamerasLookFromAsFar) {
 TEST(ViewerProjective, LookingThroughASourceCameraHidesItsFrustum) {
   EnsureGlContext();
   const ViewerScene scene = SmallScene();
-  Renderer renderer(scene);
-  RenderSettings settings;
+  SceneRenderer renderer(scene);
+  FrameSettings settings;
   settings.shadows = ShadowMode::kNone;
   settings.show_grid = false;
   const ViewCamera view = SourceViewCamera(scene, "0006");
-  const RenderResult with = renderer.Render(view, settings);
+  const FrameResult with = renderer.Render(view, settings);
   settings.show_cameras = false;
-  const RenderResult without = renderer.Render(view, settings);
+  const FrameResult without = renderer.Render(view, settings);
   int different = 0;
   for (int y = 0; y < with.colour.Height(); ++y) {
     for (int x = 0; x < with.colour.Width(); ++x) {

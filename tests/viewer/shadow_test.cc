@@ -16,7 +16,7 @@ namespace {
 using namespace viewer_test;
 
 // Set PARALLAX_VIEWER_TEST_OUT=<dir> to keep the rendered images for a look.
-void MaybeSave(const std::string& name, const RenderResult& result) {
+void MaybeSave(const std::string& name, const FrameResult& result) {
   const char* dir = std::getenv("PARALLAX_VIEWER_TEST_OUT");
   if (!dir) return;
   std::filesystem::create_directories(dir);
@@ -38,12 +38,12 @@ TEST(ViewerShadows, ShadowMapMatchesRayTracedMask) {
   EnsureGlContext();
   const ViewerScene scene = BoxOnGround();
   ASSERT_TRUE(scene.ground.has_value());
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const ViewCamera view = TestView(scene);
   const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, kLight);
   for (const auto& [mode, min_iou, name] : {std::tuple{ShadowMode::kMap, 0.95, "map"},
                                             std::tuple{ShadowMode::kPcf, 0.90, "pcf"}}) {
-    const RenderResult result = renderer.Render(view, ShadowSettings(mode, kLight));
+    const FrameResult result = renderer.Render(view, ShadowSettings(mode, kLight));
     MaybeSave(std::string("shadow_") + name, result);
     const MaskComparison all = CompareMasks(reference, result.aux, [](const ReferencePixel&) { return true; });
     // Cast shadows alone (the ground), without the box's faces turned away from the light.
@@ -60,10 +60,10 @@ TEST(ViewerShadows, ShadowMapMatchesRayTracedMask) {
 TEST(ViewerShadows, PlanarShadowsMatchRayTracedMaskOnTheGround) {
   EnsureGlContext();
   const ViewerScene scene = BoxOnGround();
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const ViewCamera view = TestView(scene);
   const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, kLight);
-  const RenderResult result = renderer.Render(view, ShadowSettings(ShadowMode::kPlanar, kLight));
+  const FrameResult result = renderer.Render(view, ShadowSettings(ShadowMode::kPlanar, kLight));
   MaybeSave("shadow_planar", result);
   const MaskComparison ground = CompareMasks(reference, result.aux,
                                              [](const ReferencePixel& p) { return std::abs(p.point.z()) < 1e-3; });
@@ -81,7 +81,7 @@ TEST(ViewerShadows, PlanarShadowsAreSkippedWithANoteWithoutAGround) {
   sphere.radius = 1;
   const ViewerScene scene = SceneFromObjects({sphere});
   EXPECT_FALSE(scene.ground.has_value());
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   renderer.Render(TestView(scene), ShadowSettings(ShadowMode::kPlanar, kLight));
   const std::vector<std::string> notes = renderer.TakeNotes();
   ASSERT_EQ(notes.size(), 1u);
@@ -91,11 +91,11 @@ TEST(ViewerShadows, PlanarShadowsAreSkippedWithANoteWithoutAGround) {
 TEST(ViewerShadows, LitPlaneFacingTheLightHasNoAcne) {
   EnsureGlContext();
   const ViewerScene scene = SceneFromObjects({Plane(10)});
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const ViewCamera view = OrbitViewCamera(scene, 30, 40, 640, 480, 50);
   for (const Eigen::Vector3d& light : {Eigen::Vector3d(0, 0, -1), kLight, Eigen::Vector3d(-1, 0, -0.3).normalized()}) {
     for (ShadowMode mode : {ShadowMode::kMap, ShadowMode::kPcf}) {
-      const RenderResult result = renderer.Render(view, ShadowSettings(mode, light));
+      const FrameResult result = renderer.Render(view, ShadowSettings(mode, light));
       int covered = 0, shadowed = 0;
       for (int y = 0; y < result.aux.Height(); ++y) {
         for (int x = 0; x < result.aux.Width(); ++x) {
@@ -118,13 +118,13 @@ TEST(ViewerShadows, LitPlaneFacingTheLightHasNoAcne) {
 TEST(ViewerShadows, ContactShadowStartsAtTheBox) {
   EnsureGlContext();
   const ViewerScene scene = SceneFromObjects({Plane(10), Box({0, 0, 1}, {2, 2, 2})});
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   ViewCamera view;
   view.camera = ViewerCamera(640, 480, 2.5);
   view.cam_from_world = LookAt({0, 0, 200}, {0, 0, 0}, {0, 1, 0});  // Image x = world x.
   const Eigen::Vector3d light = Eigen::Vector3d(1, 0.0, -1).normalized();  // Shadow towards +x.
   for (ShadowMode mode : {ShadowMode::kMap, ShadowMode::kPcf}) {
-    const RenderResult result = renderer.Render(view, ShadowSettings(mode, light));
+    const FrameResult result = renderer.Render(view, ShadowSettings(mode, light));
     MaybeSave(mode == ShadowMode::kMap ? "contact_map" : "contact_pcf", result);
     int worst_gap = 0, rows = 0;
     for (int y = 180; y < 300; ++y) {
@@ -151,7 +151,7 @@ TEST(ViewerShadows, ThinBoxDoesNotZFightWithTheGroundAtNearFarRatioOneMillion) {
   EnsureGlContext();
   const double size = 10, thickness = 1e-3 * size;
   const ViewerScene scene = SceneFromObjects({Plane(size), Box({0, 0, thickness / 2}, {4, 4, thickness})});
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   ViewCamera view;
   view.camera = ViewerCamera(640, 480, 8);
   view.cam_from_world = OrbitPose({0, 0, 0}, {0, 0, 1}, 30, 40, 10 * size);
@@ -159,10 +159,10 @@ TEST(ViewerShadows, ThinBoxDoesNotZFightWithTheGroundAtNearFarRatioOneMillion) {
   const MeshRaycaster raycaster(scene.mesh.vertices, scene.mesh.triangles);
   const std::vector<RayHit> hits = raycaster.CastPixels(view.camera, view.cam_from_world);
   for (bool reverse_z : {true, false}) {
-    RenderSettings settings = ShadowSettings(ShadowMode::kNone, Eigen::Vector3d(0, 0, -1));
+    FrameSettings settings = ShadowSettings(ShadowMode::kNone, Eigen::Vector3d(0, 0, -1));
     settings.reverse_z = reverse_z;
     if (!reverse_z) view.near = 0;  // Without reverse-Z the near plane is fitted to the scene.
-    const RenderResult result = renderer.Render(view, settings);
+    const FrameResult result = renderer.Render(view, settings);
     int box_pixels = 0, fighting = 0;
     for (int y = 0; y < 480; ++y) {
       for (int x = 0; x < 640; ++x) {
@@ -184,7 +184,7 @@ TEST(ViewerShadows, ThinBoxDoesNotZFightWithTheGroundAtNearFarRatioOneMillion) {
 TEST(ViewerShadows, GrazingLightGivesNoNanAndNoFullScreenAcne) {
   EnsureGlContext();
   const ViewerScene scene = BoxOnGround();
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const ViewCamera view = TestView(scene);
   // 89.9 degrees from the ground's normal.
   const double elevation = 0.1 * std::numbers::pi / 180;
@@ -193,7 +193,7 @@ TEST(ViewerShadows, GrazingLightGivesNoNanAndNoFullScreenAcne) {
                                                  std::cos(elevation) * across.y(), std::sin(elevation));
   const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, light);
   for (ShadowMode mode : {ShadowMode::kMap, ShadowMode::kPcf, ShadowMode::kPlanar}) {
-    const RenderResult result = renderer.Render(view, ShadowSettings(mode, light));
+    const FrameResult result = renderer.Render(view, ShadowSettings(mode, light));
     for (float v : result.colour.Pixels()) ASSERT_TRUE(std::isfinite(v));
     for (float v : result.aux.Pixels()) ASSERT_TRUE(std::isfinite(v));
     // Pixels shadowed by the renderer that the ray tracer sees lit.
@@ -219,9 +219,9 @@ TEST(ViewerShadows, GrazingLightGivesNoNanAndNoFullScreenAcne) {
 TEST(ViewerShadows, FrameTimeAt1280x720WithPcf) {
   EnsureGlContext();
   const ViewerScene scene = BoxOnGround();
-  Renderer renderer(scene);
+  SceneRenderer renderer(scene);
   const ViewCamera view = OrbitViewCamera(scene, 200, 35, 1280, 720, 50);
-  RenderSettings settings = ShadowSettings(ShadowMode::kPcf, kLight);
+  FrameSettings settings = ShadowSettings(ShadowMode::kPcf, kLight);
   renderer.Render(view, settings);  // Warm up: shader compilation, allocations.
   for (bool moving_light : {false, true}) {
     std::vector<double> ms;

@@ -158,9 +158,9 @@ MaskComparison CompareMasks(const std::vector<ReferencePixel>& reference, const 
   return result;
 }
 
-// Renderer settings for shadow measurements: grey albedo, nothing but the mesh.
-inline RenderSettings ShadowSettings(ShadowMode mode, const Eigen::Vector3d& light_direction) {
-  RenderSettings settings;
+// SceneRenderer settings for shadow measurements: grey albedo, nothing but the mesh.
+inline FrameSettings ShadowSettings(ShadowMode mode, const Eigen::Vector3d& light_direction) {
+  FrameSettings settings;
   settings.shadows = mode;
   settings.texture = TextureMode::kShaded;
   settings.light.direction = light_direction;
