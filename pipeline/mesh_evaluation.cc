@@ -8,9 +8,9 @@
 namespace parallax {
 namespace fs = std::filesystem;
 
-Image RenderTexturedMesh(const TexturedMesh& mesh, const Camera& camera,
-                         const Rigid3d& cam_from_world, std::vector<uint8_t>& covered) {
-  const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
+Image RenderTexturedMesh(const TexturedMesh& mesh, const MeshRaycaster& raycaster,
+                         const Camera& camera, const Rigid3d& cam_from_world,
+                         std::vector<uint8_t>& covered) {
   const std::vector<RayHit> hits = raycaster.CastPixels(camera, cam_from_world);
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   Image render(width, height, 3);
@@ -34,6 +34,7 @@ TexturedMeshScore ScoreTexturedMesh(const TexturedMesh& mesh, const SparseModel&
                                     const fs::path& images_dir, const fs::path& render_dir) {
   TexturedMeshScore score;
   if (!render_dir.empty()) fs::create_directories(render_dir);
+  const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
   for (const SparseImage& image : model.Images()) {
     const Camera& camera = model.CameraById(image.camera_id);
     const Image photo = ReadImage(images_dir / image.name);
@@ -43,7 +44,7 @@ TexturedMeshScore ScoreTexturedMesh(const TexturedMesh& mesh, const SparseModel&
                           ": not an RGB image of its camera's size");
     }
     std::vector<uint8_t> covered;
-    const Image render = RenderTexturedMesh(mesh, camera, image.cam_from_world, covered);
+    const Image render = RenderTexturedMesh(mesh, raycaster, camera, image.cam_from_world, covered);
     double squared_error = 0;
     size_t pixels = 0;
     for (int y = 0; y < render.Height(); ++y) {

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "core/sparse_model.h"
+#include "pipeline/raycaster.h"
 #include "pipeline/textured_mesh.h"
 
 namespace parallax {
@@ -22,7 +23,9 @@ TexturedMeshScore ScoreTexturedMesh(const TexturedMesh& mesh, const SparseModel&
                                     const std::filesystem::path& render_dir);
 
 // The textured mesh seen from a camera: sRGB colour where covered, `covered` set there.
-Image RenderTexturedMesh(const TexturedMesh& mesh, const Camera& camera,
-                         const Rigid3d& cam_from_world, std::vector<uint8_t>& covered);
+// `raycaster` holds `mesh`'s triangles (built once, shared by all views).
+Image RenderTexturedMesh(const TexturedMesh& mesh, const MeshRaycaster& raycaster,
+                         const Camera& camera, const Rigid3d& cam_from_world,
+                         std::vector<uint8_t>& covered);
 
 }  // namespace parallax

@@ -133,22 +133,24 @@ TexturedMesh ReadTexturedMesh(const fs::path& obj_path) {
   return mesh;
 }
 
-Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv) {
-  // Texel centres sit at integer + 0.5; v runs up, rows run down.
-  const float x = std::clamp(uv.x() * static_cast<float>(atlas.Width()) - 0.5f, 0.0f,
-                             static_cast<float>(atlas.Width() - 1));
-  const float y = std::clamp((1.0f - uv.y()) * static_cast<float>(atlas.Height()) - 0.5f, 0.0f,
-                             static_cast<float>(atlas.Height() - 1));
+Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel) {
+  const float x = std::clamp(pixel.x() - 0.5f, 0.0f, static_cast<float>(image.Width() - 1));
+  const float y = std::clamp(pixel.y() - 0.5f, 0.0f, static_cast<float>(image.Height() - 1));
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, atlas.Width() - 1), y1 = std::min(y0 + 1, atlas.Height() - 1);
+  const int x1 = std::min(x0 + 1, image.Width() - 1), y1 = std::min(y0 + 1, image.Height() - 1);
   const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
   Eigen::Vector3f colour;
   for (int c = 0; c < 3; ++c) {
-    const float top = (1 - fx) * atlas.At(x0, y0, c) + fx * atlas.At(x1, y0, c);
-    const float bottom = (1 - fx) * atlas.At(x0, y1, c) + fx * atlas.At(x1, y1, c);
-    colour[c] = (1 - fy) * top + fy * bottom;
+    colour[c] = (1 - fy) * ((1 - fx) * image.At(x0, y0, c) + fx * image.At(x1, y0, c)) +
+                fy * ((1 - fx) * image.At(x0, y1, c) + fx * image.At(x1, y1, c));
   }
   return colour;
+}
+
+Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv) {
+  // v runs up, rows run down.
+  return SampleBilinear(atlas, Eigen::Vector2f(uv.x() * static_cast<float>(atlas.Width()),
+                                               (1.0f - uv.y()) * static_cast<float>(atlas.Height())));
 }
 
 }  // namespace parallax

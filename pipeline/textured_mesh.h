@@ -27,7 +27,11 @@ void WriteTexturedMesh(const std::filesystem::path& dir, const TexturedMesh& mes
 // (map_Kd). Throws BadInputError naming the file and line for anything malformed.
 TexturedMesh ReadTexturedMesh(const std::filesystem::path& obj_path);
 
-// Atlas colour at `uv`, bilinear between texel centres, clamped at the border.
+// Colour (first 3 channels) at a continuous pixel position (pixel centres at integer + 0.5),
+// bilinear between pixel centres, clamped at the border.
+Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel);
+
+// Atlas colour at `uv` (OBJ convention), through SampleBilinear.
 Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv);
 
 }  // namespace parallax

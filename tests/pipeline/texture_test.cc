@@ -72,7 +72,9 @@ TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
   EXPECT_GE(summary.texels_per_edge, 2);
 
   std::vector<uint8_t> covered;
-  const Image render = RenderTexturedMesh(mesh, view.camera, view.cam_from_world, covered);
+  const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
+  const Image render =
+      RenderTexturedMesh(mesh, raycaster, view.camera, view.cam_from_world, covered);
   double squared = 0;
   int pixels = 0;
   for (int y = 0; y < 72; ++y) {
