@@ -150,7 +150,14 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // rectified pairs of these converging cameras, and PatchMatch beats it.
   const MvsSummary sgbm_run =
       RunSgbmStereo(workspace.Path(), MvsOptionsFor(Quality::kBalanced).views, {}, progress);
-  EXPECT_EQ(sgbm_run.views.size(), 12u);
+  // Every view gets SGBM depth except, at times, the arc's end camera: whether one of its
+  // selected sources lies to its right depends on the triangulated points (COLMAP runs
+  // multi-threaded), and without one it is skipped, with that reason.
+  EXPECT_EQ(sgbm_run.views.size() + sgbm_run.skipped.size(), 12u);
+  EXPECT_GE(sgbm_run.views.size(), 11u);
+  for (const std::string& skipped : sgbm_run.skipped) {
+    EXPECT_NE(skipped.find("no source view to its right"), std::string::npos) << skipped;
+  }
   const DepthEvaluation sgbm =
       EvaluateDepth(model, workspace.Path() / "depth", truth, scene.Training().depth, {}, {});
   EXPECT_GT(sgbm.completeness, 0.3);
