@@ -11,6 +11,7 @@
 #include "core/image.h"
 #include "core/sparse_model.h"
 #include "pipeline/ply.h"
+#include "pipeline/simplify.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -109,6 +110,7 @@ void MeshOptions::Check() const {
     throw std::invalid_argument("mesh: poisson_depth must be in 5..14");
   }
   if (!(max_cells_from_data > 0)) throw std::invalid_argument("mesh: max_cells_from_data must be > 0");
+  if (display_max_triangles < 1) throw std::invalid_argument("mesh: display_max_triangles must be >= 1");
   texture.Check();
 }
 
@@ -143,13 +145,25 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   progress.Update("trim", 1, 1);
 
   progress.Update("texture", 0, 1);
+  const std::vector<TextureView> views = LoadTextureViews(workspace);
   TextureSummary texture;
-  const TexturedMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles,
-                                            LoadTextureViews(workspace), options.texture, texture);
+  const TexturedMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
   WriteTexturedMesh(workspace / "mesh", textured);
   progress.Update("texture", 1, 1);
 
   MeshSummary summary;
+  const fs::path display = workspace / "mesh_display";
+  if (trimmed.triangles.size() > options.display_max_triangles) {
+    progress.Update("display mesh", 0, 1);
+    const PlyMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
+    TextureSummary display_texture;
+    WriteTexturedMesh(display, TextureMesh(simplified.vertices, simplified.triangles, views, options.texture,
+                                           display_texture));
+    summary.display_triangles = simplified.triangles.size();
+    progress.Update("display mesh", 1, 1);
+  } else {
+    fs::remove_all(display);  // A stale one from a larger mesh would be shown instead.
+  }
   summary.poisson_triangles = raw.triangles.size();
   summary.triangles = trimmed.triangles.size();
   summary.vertices = trimmed.vertices.size();

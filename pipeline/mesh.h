@@ -1,7 +1,7 @@
 #pragma once
 // The mesh stage of `parallax reconstruct`: fused cloud -> `colmap poisson_mesher` (screened
 // Poisson, watertight) -> trimmed to where the cloud has data -> textured from the photos ->
-// <ws>/mesh/mesh.obj|.mtl|.png.
+// <ws>/mesh/mesh.obj|.mtl|.png, and a simplified copy for display -> <ws>/mesh_display/.
 #include <filesystem>
 
 #include "core/progress.h"
@@ -17,6 +17,10 @@ struct MeshOptions {
   // Poisson closes the surface everywhere, also where no photo saw anything; a triangle is
   // kept only if each of its corners lies within this many octree cells of a fused point.
   double max_cells_from_data = 2;
+  // The viewer's level of detail: a mesh with more triangles also gets a simplified copy with
+  // at most this many (about one per 28 pixels of a 1280x720 view), textured on its own, which
+  // the viewer draws when the full mesh would have more triangles than the pixels need.
+  size_t display_max_triangles = 32768;
   TextureOptions texture;
   void Check() const;
 };
@@ -31,10 +35,12 @@ struct MeshSummary {
   int texels_per_edge = 0;
   size_t untextured_triangles = 0;
   int atlas_width = 0, atlas_height = 0;
+  size_t display_triangles = 0;  // 0: the mesh is small enough to display as it is.
 };
 
-// Reads <ws>/fused.ply, <ws>/sparse and <ws>/images; writes <ws>/mesh/ (atomically) and the
-// raw Poisson mesh to <ws>/mesh_poisson.ply. Throws BadInputError for an empty cloud,
+// Reads <ws>/fused.ply, <ws>/sparse and <ws>/images; writes <ws>/mesh/ and <ws>/mesh_display/
+// (each atomically; the latter only for a mesh over the display budget, else it is removed) and
+// the raw Poisson mesh to <ws>/mesh_poisson.ply. Throws BadInputError for an empty cloud,
 // ToolError if colmap fails.
 MeshSummary MeshWorkspace(const std::filesystem::path& workspace, const Colmap& colmap,
                           const MeshOptions& options, Progress& progress);

@@ -78,7 +78,7 @@ uint64_t HashFolder(const fs::path& dir) {
 // Bump when the depth stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-6";
 constexpr const char* kFusionVersion = "fusion-1";
-constexpr const char* kMeshVersion = "mesh-1";
+constexpr const char* kMeshVersion = "mesh-2";
 
 nlohmann::json MeshSummaryJson(const MeshSummary& mesh) {
   return {{"poisson_triangles", mesh.poisson_triangles},
@@ -86,7 +86,8 @@ nlohmann::json MeshSummaryJson(const MeshSummary& mesh) {
           {"vertices", mesh.vertices},
           {"texels_per_edge", mesh.texels_per_edge},
           {"untextured_triangles", mesh.untextured_triangles},
-          {"atlas_size", {mesh.atlas_width, mesh.atlas_height}}};
+          {"atlas_size", {mesh.atlas_width, mesh.atlas_height}},
+          {"display_triangles", mesh.display_triangles}};
 }
 
 nlohmann::json MvsSummaryJson(const MvsSummary& mvs) {

@@ -10,32 +10,26 @@
 #include <string_view>
 
 #include "viewer/gl.h"
+#include "viewer/gpu_resources.h"
 #include "viewer/shaders.h"
 #include "viewer/view_math.h"
 
 namespace parallax {
 namespace {
 
+using gpu::DepthTarget;
+using gpu::Drawable;
+using gpu::EyeTarget;
+using gpu::GpuMesh;
+using gpu::Upload;
+using gpu::Vertex;
+using gpu::kAtlasUnit, gpu::kShadowUnit, gpu::kPhotoUnit, gpu::kProjectorDepthUnit;
+
 constexpr int kMaxProjectors = 3;
-// Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7. Textures are
-// created on a unit of their own, so making one never disturbs what a sampler is bound to.
-constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5;
-constexpr int kScratchUnit = 15;
-
-GlTexture MakeTextureOnScratchUnit() {
-  glActiveTexture(GL_TEXTURE0 + kScratchUnit);
-  GlTexture texture = MakeGlTexture();
-  glBindTexture(GL_TEXTURE_2D, texture.Get());
-  return texture;
-}
-
-// One vertex of every buffer the viewer draws; unused attributes stay zero.
-struct Vertex {
-  float position[3];
-  float normal[3];
-  float uv[2];
-  float colour[3];
-};
+// The display mesh (a simplified copy, when the workspace has one) is drawn when the full mesh
+// would give a triangle to fewer pixels than this: finer triangles cost llvmpipe vertex and
+// setup work without adding detail the atlas does not already show.
+constexpr int kPixelsPerTriangle = 16;
 
 bool HasExtension(std::string_view name) {
   GLint count = 0;
@@ -46,124 +40,6 @@ bool HasExtension(std::string_view name) {
     }
   }
   return false;
-}
-
-// A vertex array over `vertices` with the attribute layout of the shaders.
-struct Drawable {
-  GlVertexArray vao;
-  GlBuffer buffer;
-  GLsizei count = 0;
-};
-
-Drawable Upload(const std::vector<Vertex>& vertices) {
-  Drawable d{MakeGlVertexArray(), MakeGlBuffer(), static_cast<GLsizei>(vertices.size())};
-  glBindVertexArray(d.vao.Get());
-  glBindBuffer(GL_ARRAY_BUFFER, d.buffer.Get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)),
-               vertices.data(), GL_STATIC_DRAW);
-  const auto attribute = [](GLuint index, GLint size, size_t offset) {
-    glEnableVertexAttribArray(index);
-    glVertexAttribPointer(index, size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                          reinterpret_cast<const void*>(offset));
-  };
-  attribute(0, 3, offsetof(Vertex, position));
-  attribute(1, 3, offsetof(Vertex, normal));
-  attribute(2, 2, offsetof(Vertex, uv));
-  attribute(3, 3, offsetof(Vertex, colour));
-  glBindVertexArray(0);
-  return d;
-}
-
-// The mesh's positions, shared between triangles and drawn by index, for depth-only passes
-// (the eye's pre-pass, shadow maps, projector depth): a third of the vertex work of the
-// per-corner buffer below, a quarter of its bytes. Position 0 is the only attribute.
-struct IndexedMesh {
-  GlVertexArray vao;
-  GlBuffer positions, indices;  // `positions`: the vertex buffer (whole Vertex for the shaded mesh).
-  GLsizei count = 0;  // Indices.
-};
-
-IndexedMesh UploadPositions(const TexturedMesh& mesh) {
-  static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(Eigen::Vector3i) == 3 * sizeof(GLuint),
-                "uploaded as packed arrays");
-  IndexedMesh d{MakeGlVertexArray(), MakeGlBuffer(), MakeGlBuffer(), static_cast<GLsizei>(mesh.triangles.size() * 3)};
-  glBindVertexArray(d.vao.Get());
-  glBindBuffer(GL_ARRAY_BUFFER, d.positions.Get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(float) * 3),
-               mesh.vertices.data(), GL_STATIC_DRAW);
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, d.indices.Get());
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(int) * 3),
-               mesh.triangles.data(), GL_STATIC_DRAW);
-  glBindVertexArray(0);
-  return d;
-}
-
-// The mesh for the eye's shaded pass: a vertex per distinct (position, atlas coordinate), drawn
-// by index, so triangles inside an atlas chart share their corners and llvmpipe shades far
-// fewer vertices. No normals: the surface shader takes the face normal from the position's
-// screen derivatives.
-IndexedMesh UploadShadedMesh(const TexturedMesh& mesh) {
-  std::vector<Vertex> vertices;
-  std::vector<GLuint> indices;
-  indices.reserve(mesh.triangles.size() * 3);
-  const bool has_uv = mesh.corner_uvs.size() == mesh.triangles.size() * 3;
-  std::map<std::tuple<int, float, float>, GLuint> index_of;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    for (int c = 0; c < 3; ++c) {
-      const int v = mesh.triangles[t][c];
-      const Eigen::Vector2f uv = has_uv ? mesh.corner_uvs[3 * t + c] : Eigen::Vector2f(0.5f, 0.5f);
-      const auto [found, inserted] = index_of.try_emplace({v, uv.x(), uv.y()}, static_cast<GLuint>(vertices.size()));
-      if (inserted) {
-        const Eigen::Vector3f& p = mesh.vertices[v];
-        vertices.push_back({{p.x(), p.y(), p.z()}, {0, 0, 0}, {uv.x(), 1 - uv.y()}, {0, 0, 0}});
-      }
-      indices.push_back(found->second);
-    }
-  }
-  IndexedMesh d{MakeGlVertexArray(), MakeGlBuffer(), MakeGlBuffer(), static_cast<GLsizei>(indices.size())};
-  glBindVertexArray(d.vao.Get());
-  glBindBuffer(GL_ARRAY_BUFFER, d.positions.Get());
-  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STATIC_DRAW);
-  const auto attribute = [](GLuint index, GLint size, size_t offset) {
-    glEnableVertexAttribArray(index);
-    glVertexAttribPointer(index, size, GL_FLOAT, GL_FALSE, sizeof(Vertex), reinterpret_cast<const void*>(offset));
-  };
-  attribute(0, 3, offsetof(Vertex, position));
-  attribute(1, 3, offsetof(Vertex, normal));
-  attribute(2, 2, offsetof(Vertex, uv));
-  attribute(3, 3, offsetof(Vertex, colour));
-  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, d.indices.Get());
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(GLuint)), indices.data(), GL_STATIC_DRAW);
-  glBindVertexArray(0);
-  return d;
-}
-
-// The planar shadow casters' mesh: three vertices per triangle, each with its face normal and
-// its corner's atlas coordinate (t = 1 - v: the atlas is uploaded top row first). colour.x of a mesh vertex holds its triangle's greatest height above the ground, so planar
-// shadows can drop the ground's own triangles without also dropping the foot of a wall.
-std::vector<Vertex> MeshVertices(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground) {
-  std::vector<Vertex> vertices;
-  vertices.reserve(mesh.triangles.size() * 3);
-  const bool has_uv = mesh.corner_uvs.size() == mesh.triangles.size() * 3;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Eigen::Vector3i& tri = mesh.triangles[t];
-    Eigen::Vector3f normal =
-        (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    normal = normal.norm() > 0 ? Eigen::Vector3f(normal.normalized()) : Eigen::Vector3f::Zero();
-    float max_height = 0;
-    for (int c = 0; c < 3 && ground; ++c) {
-      max_height = std::max(max_height, static_cast<float>(ground->SignedDistance(mesh.vertices[tri[c]].cast<double>())));
-    }
-    for (int c = 0; c < 3; ++c) {
-      const Eigen::Vector3f& p = mesh.vertices[tri[c]];
-      const Eigen::Vector2f uv = has_uv ? mesh.corner_uvs[3 * t + c] : Eigen::Vector2f(0.5f, 0.5f);
-      vertices.push_back({{p.x(), p.y(), p.z()}, {normal.x(), normal.y(), normal.z()},
-                          {uv.x(), 1 - uv.y()}, {max_height, 0, 0}});
-    }
-  }
-  return vertices;
 }
 
 std::vector<Vertex> PointVertices(const std::vector<ColouredPoint>& points) {
@@ -284,102 +160,6 @@ std::vector<Vertex> GridLines(const ViewerScene& scene) {
   return lines;
 }
 
-void SetTextureParameters(GLenum filter, GLenum wrap) {
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, static_cast<GLint>(wrap));
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, static_cast<GLint>(wrap));
-}
-
-// An sRGB texture of an image (values in [0, 1], sRGB-encoded), top row first; sampling returns
-// linear values.
-GlTexture UploadSrgbTexture(const Image& image) {
-  std::vector<uint8_t> bytes(static_cast<size_t>(image.Width()) * image.Height() * 3);
-  for (int y = 0; y < image.Height(); ++y) {
-    for (int x = 0; x < image.Width(); ++x) {
-      for (int c = 0; c < 3; ++c) {
-        const float value = image.At(x, y, std::min(c, image.Channels() - 1));
-        bytes[(static_cast<size_t>(y) * image.Width() + x) * 3 + c] =
-            static_cast<uint8_t>(std::lround(std::clamp(value, 0.0f, 1.0f) * 255));
-      }
-    }
-  }
-  GlTexture texture = MakeTextureOnScratchUnit();
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8, image.Width(), image.Height(), 0, GL_RGB,
-               GL_UNSIGNED_BYTE, bytes.data());
-  glGenerateMipmap(GL_TEXTURE_2D);
-  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
-  // Bilinear in the nearest mip level: half the texel fetches of trilinear, ~2 ms a 720p frame
-  // on llvmpipe, and within 50 dB of it on the courtyard.
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
-  return texture;
-}
-
-// A depth texture for hardware comparison, with an FBO that renders into it.
-struct DepthTarget {
-  GlTexture texture;
-  GlFramebuffer framebuffer;
-  int width = 0, height = 0;
-
-  void Resize(int new_width, int new_height) {
-    if (width == new_width && height == new_height && texture.Get() != 0) return;
-    width = new_width;
-    height = new_height;
-    texture = MakeTextureOnScratchUnit();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, width, height, 0, GL_DEPTH_COMPONENT,
-                 GL_FLOAT, nullptr);
-    SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_BORDER);
-    // Outside the map is lit: border depth 1 never occludes.
-    const float border[4] = {1, 1, 1, 1};
-    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    framebuffer = MakeGlFramebuffer();
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, texture.Get(), 0);
-    glDrawBuffer(GL_NONE);
-    glReadBuffer(GL_NONE);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw std::runtime_error("GL: depth framebuffer incomplete");
-    }
-  }
-};
-
-// The frame: sRGB-encoded colour (RGBA8), auxiliary float RGBA, float depth + stencil.
-struct EyeTarget {
-  GlFramebuffer framebuffer;
-  GlTexture colour, aux;
-  GlRenderbuffer depth_stencil;
-  int width = 0, height = 0;
-
-  void Resize(int new_width, int new_height) {
-    if (width == new_width && height == new_height && framebuffer.Get() != 0) return;
-    width = new_width;
-    height = new_height;
-    colour = MakeTextureOnScratchUnit();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
-    SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
-    aux = MakeTextureOnScratchUnit();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
-    SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
-    depth_stencil = MakeGlRenderbuffer();
-    glBindRenderbuffer(GL_RENDERBUFFER, depth_stencil.Get());
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, width, height);
-    framebuffer = MakeGlFramebuffer();
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour.Get(), 0);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, aux.Get(), 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
-                              depth_stencil.Get());
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      throw std::runtime_error("GL: frame buffer incomplete");
-    }
-  }
-};
-
 }  // namespace
 
 void FrameSettings::Check() const {
@@ -417,9 +197,10 @@ struct ShadowMapKey {
   Eigen::Matrix4f light_clip_from_world;
   int size = 0;
   float slope_bias = 0;
+  const GpuMesh* casters = nullptr;  // The level of detail drawn into it.
   bool operator==(const ShadowMapKey& other) const {
     return light_clip_from_world == other.light_clip_from_world && size == other.size &&
-           slope_bias == other.slope_bias;
+           slope_bias == other.slope_bias && casters == other.casters;
   }
 };
 
@@ -434,12 +215,11 @@ struct SceneRenderer::Impl {
   Eigen::Vector3f projector_centre[kMaxProjectors];
   Eigen::Vector4f ground_plane = Eigen::Vector4f::Zero();
   float ground_tolerance = 0;
-  Drawable mesh, points, frusta, grid;
-  IndexedMesh mesh_positions;  // The same mesh for depth-only passes.
-  IndexedMesh mesh_shaded;     // And for the eye's shaded passes.
+  GpuMesh full_mesh, display_mesh;  // display_mesh is empty without a simplified copy.
+  const GpuMesh* mesh = &full_mesh;  // This frame's level of detail (shadows and eye alike).
+  Drawable points, frusta, grid;
   double frustum_depth = 0;  // Scene units.
   std::vector<Eigen::Vector3d> source_centres;
-  GlTexture atlas;
   DepthTarget shadow;
   std::optional<ShadowMapKey> shadow_key;  // Absent until the map holds a rendering.
   DepthTarget projector_depth[kMaxProjectors];
@@ -469,11 +249,11 @@ struct SceneRenderer::Impl {
   }
   // What casts shadows and occludes projectors: the mesh when there is one, else the points.
   void DrawCasters(const FrameSettings& settings, const GlProgram& program) {
-    if (mesh.count > 0 && &program == &depth) {
+    if (mesh->triangles > 0 && &program == &depth) {
       DrawMeshDepth();
-    } else if (mesh.count > 0) {
-      glBindVertexArray(mesh.vao.Get());
-      glDrawArrays(GL_TRIANGLES, 0, mesh.count);
+    } else if (mesh->triangles > 0) {
+      glBindVertexArray(mesh->casters.vao.Get());
+      glDrawArrays(GL_TRIANGLES, 0, mesh->casters.count);
     } else if (points.count > 0) {
       program.Set("u_point_size", settings.point_size_px);
       glBindVertexArray(points.vao.Get());
@@ -482,8 +262,8 @@ struct SceneRenderer::Impl {
   }
   // The mesh through the depth program (bound by the caller).
   void DrawMeshDepth() const {
-    glBindVertexArray(mesh_positions.vao.Get());
-    glDrawElements(GL_TRIANGLES, mesh_positions.count, GL_UNSIGNED_INT, nullptr);
+    glBindVertexArray(mesh->positions.vao.Get());
+    glDrawElements(GL_TRIANGLES, mesh->positions.count, GL_UNSIGNED_INT, nullptr);
   }
   // The frusta, but those of cameras within three frustum depths of the eye: the one looked
   // through, or one just in front of the eye, would cross the whole image.
@@ -534,7 +314,7 @@ void SceneRenderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matri
 GLuint SceneRenderer::Impl::Photo(int source) {
   auto found = photos.find(source);
   if (found == photos.end()) {
-    found = photos.emplace(source, UploadSrgbTexture(ReadImage(scene.sources[source].image_path))).first;
+    found = photos.emplace(source, gpu::UploadSrgbTexture(ReadImage(scene.sources[source].image_path))).first;
   }
   return found->second.Get();
 }
@@ -604,7 +384,7 @@ void SceneRenderer::Impl::UseSurfaceProgram(const GlProgram& program, const View
     program.Set(("u_projector_from_world[" + index + "]").c_str(), projector_from_world[k]);
     program.Set(("u_projector_centre[" + index + "]").c_str(), projector_centre[k]);
   }
-  program.Set("u_has_atlas", atlas.Get() != 0 ? 1 : 0);
+  program.Set("u_has_atlas", mesh->atlas.Get() != 0 ? 1 : 0);
   program.Set("u_ground", ground_plane);
   program.Set("u_ground_tolerance", ground_tolerance);
   program.Set("u_point_size", settings.point_size_px);
@@ -616,7 +396,7 @@ void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettin
   const int albedo = settings.texture == TextureMode::kProjective ? 1
                      : settings.texture == TextureMode::kShaded ? 2
                                                                : 0;
-  if (settings.show_mesh && mesh.count > 0) {
+  if (settings.show_mesh && mesh->triangles > 0) {
     // Depth pre-pass: the mesh's depth alone first, then the shaded pass where it matches, so
     // each pixel is shaded once however much the walls and pillars overlap (fragment work
     // dominates on llvmpipe). Both vertex shaders compute an invariant gl_Position. The planar
@@ -631,17 +411,17 @@ void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettin
       glDepthMask(GL_FALSE);
       glDepthFunc(reverse_z_now ? GL_GEQUAL : GL_LEQUAL);
     }
-    UseSurfaceProgram(SurfaceProgram(albedo == 0 && atlas.Get() == 0 ? 2 : albedo, shadow_mode, settings.pcf_radius), view, settings,
+    UseSurfaceProgram(SurfaceProgram(albedo == 0 && mesh->atlas.Get() == 0 ? 2 : albedo, shadow_mode, settings.pcf_radius), view, settings,
                       clip_from_world, projectors);
-    glBindVertexArray(mesh_shaded.vao.Get());
-    glDrawElements(GL_TRIANGLES, mesh_shaded.count, GL_UNSIGNED_INT, nullptr);
+    glBindVertexArray(mesh->shaded.vao.Get());
+    glDrawElements(GL_TRIANGLES, mesh->shaded.count, GL_UNSIGNED_INT, nullptr);
     if (prepass) {
       glDepthMask(GL_TRUE);
       glDepthFunc(reverse_z_now ? GL_GREATER : GL_LESS);
     }
   }
   if (settings.show_points && points.count > 0 &&
-      (mesh.count == 0 || !settings.show_mesh || settings.points_with_mesh)) {
+      (mesh->triangles == 0 || !settings.show_mesh || settings.points_with_mesh)) {
     UseSurfaceProgram(SurfaceProgram(albedo == 0 ? 3 : albedo, shadow_mode, settings.pcf_radius), view, settings, clip_from_world,
                       projectors);
     glBindVertexArray(points.vao.Get());
@@ -671,7 +451,7 @@ void SceneRenderer::Impl::DrawPlanarShadows(const ViewCamera& view, const FrameS
   planar.Set("u_planar_shadow", PlanarShadowMatrix(ground, LightVector(settings.light)));
   planar.Set("u_ground", plane);
   planar.Set("u_ground_tolerance", tolerance);
-  planar.Set("u_points", mesh.count == 0 ? 1 : 0);
+  planar.Set("u_points", mesh->triangles == 0 ? 1 : 0);
   DrawCasters(settings, planar);
 
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -693,17 +473,13 @@ SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<
   r.depth = GlProgram("depth", shaders::kDepthVertex, shaders::kDepthFragment);
   r.planar = GlProgram("planar shadow", shaders::kPlanarVertex, shaders::kPlanarFragment);
   r.lines = GlProgram("lines", shaders::kLineVertex, shaders::kLineFragment);
-  if (!scene.mesh.triangles.empty()) {
-    r.mesh = Upload(MeshVertices(scene.mesh, scene.ground));
-    r.mesh_positions = UploadPositions(scene.mesh);
-    r.mesh_shaded = UploadShadedMesh(scene.mesh);
-  }
+  r.full_mesh = gpu::UploadMesh(scene.mesh, scene.ground);
+  r.display_mesh = gpu::UploadMesh(scene.display_mesh, scene.ground);
   if (!scene.points.empty()) r.points = Upload(PointVertices(scene.points));
   r.frustum_depth = FrustumDepth(scene);
   for (const ViewerSource& source : scene.sources) r.source_centres.push_back(CameraCenter(source.cam_from_world));
   if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, r.frustum_depth));
   r.grid = Upload(GridLines(scene));
-  if (!scene.mesh.atlas.Empty()) r.atlas = UploadSrgbTexture(scene.mesh.atlas);
 
   // Samplers must hold textures of their type even when unused: give the comparison samplers
   // a 1x1 depth map each.
@@ -727,6 +503,8 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   const bool reverse_z = r.reverse_z && settings.reverse_z;
   r.reverse_z_now = reverse_z;
   const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
+  const bool too_fine = r.full_mesh.triangles * kPixelsPerTriangle > static_cast<size_t>(width) * height;
+  r.mesh = r.display_mesh.triangles > 0 && too_fine ? &r.display_mesh : &r.full_mesh;
 
   // 1. Shadow map from the light.
   int shadow_mode_uniform = 0;
@@ -734,7 +512,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
     const Eigen::Matrix4f light_matrix = r.LightMatrix(settings.light);
     // PCF taps up to r texels away compare against the centre's depth: more slope bias.
     const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + static_cast<float>(settings.pcf_radius) : 1.5f;
-    const ShadowMapKey key{light_matrix, settings.shadow_map_size, slope_bias};
+    const ShadowMapKey key{light_matrix, settings.shadow_map_size, slope_bias, r.mesh};
     if (r.shadow_key != key) {
       r.shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
       r.RenderDepthMap(r.shadow, light_matrix, settings, slope_bias);
@@ -746,7 +524,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   glActiveTexture(GL_TEXTURE0 + kShadowUnit);
   glBindTexture(GL_TEXTURE_2D, r.shadow.texture.Get());
   glActiveTexture(GL_TEXTURE0 + kAtlasUnit);
-  glBindTexture(GL_TEXTURE_2D, r.atlas.Get());
+  glBindTexture(GL_TEXTURE_2D, r.mesh->atlas.Get());
 
   // 2. Projectors' depth maps and photos.
   int projectors = 0;

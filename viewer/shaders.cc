@@ -129,14 +129,16 @@ vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, 
 
 void main() {
   vec3 view_dir = normalize(u_eye - v_world);
+  // Points and the mesh's corners carry normals (smooth within a crease angle); where one is
+  // missing, the face normal is the cross product of the position's screen derivatives.
+  vec3 n = v_normal;
 #if ALBEDO_SOURCE == 3
-  vec3 n = length(v_normal) > 0.0 ? normalize(v_normal) : view_dir;
+  if (dot(n, n) == 0.0) n = view_dir;
 #else
-  // The mesh is flat-shaded and its shaded pass shares vertices between faces: the face normal
-  // is the cross product of the position's screen derivatives (both lie in the plane).
-  vec3 n = cross(dFdx(v_world), dFdy(v_world));
-  n = dot(n, n) > 0.0 ? normalize(n) : view_dir;
+  if (dot(n, n) == 0.0) n = cross(dFdx(v_world), dFdy(v_world));
+  if (dot(n, n) == 0.0) n = view_dir;
 #endif
+  n = normalize(n);
   // Windings of reconstructed meshes are not consistent: light the side the eye sees.
   if (dot(n, view_dir) < 0.0) n = -n;
 

@@ -241,6 +241,8 @@ ViewerScene LoadViewerScene(const fs::path& workspace) {
   const fs::path obj = workspace / "mesh" / "mesh.obj";
   const fs::path ply = workspace / "fused.ply";
   if (fs::exists(obj)) scene.mesh = ReadTexturedMesh(obj);
+  const fs::path display = workspace / "mesh_display" / "mesh.obj";
+  if (!scene.mesh.triangles.empty() && fs::exists(display)) scene.display_mesh = ReadTexturedMesh(display);
   if (fs::exists(ply)) scene.points = ReadColouredPly(ply);
   if (scene.mesh.triangles.empty() && scene.points.empty()) {
     throw BadInputError(workspace.string() +

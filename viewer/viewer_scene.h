@@ -44,6 +44,9 @@ struct CameraRig {
 
 struct ViewerScene {
   TexturedMesh mesh;                 // No triangles when the workspace has no mesh.
+  // A simplified copy for views whose pixels cannot show every triangle of `mesh`; no
+  // triangles when the workspace has none (a small mesh is displayed as it is).
+  TexturedMesh display_mesh;
   std::vector<ColouredPoint> points; // Empty when the workspace has no fused.ply.
   std::vector<ViewerSource> sources;
   Eigen::AlignedBox3f bounds;        // Exact bounds of the mesh and the points: for clipping.
@@ -66,7 +69,7 @@ struct ViewerScene {
   float FocusRadius() const { return 0.5f * focus.diagonal().norm(); }
 };
 
-// Reads <ws>/mesh/mesh.obj (+ .mtl, .png), <ws>/fused.ply and the sparse model <ws>/sparse
+// Reads <ws>/mesh/mesh.obj (+ .mtl, .png), <ws>/mesh_display/mesh.obj when present, <ws>/fused.ply and the sparse model <ws>/sparse
 // with the photos in <ws>/images, then calls FinishViewerScene. Either of the mesh and the
 // cloud may be missing, not both. A scene folder (gt/sparse, images/) is accepted for the
 // cameras too. Throws BadInputError naming the folder when there is nothing to show, or the

@@ -75,6 +75,46 @@ TEST(ViewerProjective, ScreenshotFromASourceCameraReproducesItsPhoto) {
   }
 }
 
+// The mean red share r / (r + g + b) of the covered pixels.
+double MeanRedShare(const FrameResult& frame) {
+  double sum = 0;
+  int covered = 0;
+  for (int y = 0; y < frame.colour.Height(); ++y) {
+    for (int x = 0; x < frame.colour.Width(); ++x) {
+      if (!RenderedCovered(frame.aux, x, y)) continue;
+      const double total = frame.colour.At(x, y, 0) + frame.colour.At(x, y, 1) + frame.colour.At(x, y, 2);
+      sum += total > 0 ? static_cast<double>(frame.colour.At(x, y, 0)) / total : 0;
+      ++covered;
+    }
+  }
+  return covered > 0 ? sum / covered : 0;
+}
+
+TEST(ViewerLevelOfDetail, DisplayMeshIsDrawnWhenThePixelsCannotShowEveryTriangle) {
+  EnsureGlContext();
+  ViewerScene scene = SmallScene();
+  // The same geometry with a red atlas stands in for the simplified copy: the colour tells
+  // which level was drawn.
+  scene.display_mesh = scene.mesh;
+  scene.display_mesh.atlas = Image(2, 2, 3);
+  for (int y = 0; y < 2; ++y) {
+    for (int x = 0; x < 2; ++x) scene.display_mesh.atlas.At(x, y, 0) = 0.9f;
+  }
+  SceneRenderer renderer(scene);
+  FrameSettings settings;
+  settings.shadows = ShadowMode::kPcf;
+  settings.show_cameras = false;
+  settings.show_grid = false;
+  ViewCamera view = OrbitViewCamera(scene, 30, std::nullopt, 64, 48);
+  // 16 pixels a triangle: the full mesh fits a view of this many pixels and more.
+  const size_t fits = scene.mesh.triangles.size() * 16;
+  ASSERT_LT(64u * 48u, fits) << "the small frame must be too small for the full mesh";
+  EXPECT_GT(MeanRedShare(renderer.Render(view, settings)), 0.8);
+  const int side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(fits)))) + 1;
+  view = OrbitViewCamera(scene, 30, std::nullopt, side, side);
+  EXPECT_LT(MeanRedShare(renderer.Render(view, settings)), 0.5);  // The full mesh is grey.
+}
+
 TEST(ViewerProjective, NearestSourceViewsAreThoseAroundTheEye) {
   const ViewerScene scene = SmallScene();
   const Eigen::Vector3d eye = CameraCenter(scene.sources[3].cam_from_world);

@@ -1,0 +1,83 @@
+#pragma once
+// The viewer's GPU resources: vertex buffers of the mesh, the cloud and the lines, textures, and
+// the render targets (shadow and projector depth maps, the eye's frame). Needs a current GL
+// context; every object is freed by its handle.
+#include <optional>
+#include <vector>
+
+#include "pipeline/textured_mesh.h"
+#include "viewer/gl.h"
+#include "viewer/ground_plane.h"
+
+namespace parallax::gpu {
+
+// Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7. Textures are
+// created on a unit of their own, so making one never disturbs what a sampler is bound to.
+constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5;
+constexpr int kScratchUnit = 15;
+
+// A texture created and bound on the scratch unit.
+GlTexture MakeTextureOnScratchUnit();
+
+// One vertex of every buffer the viewer draws; unused attributes stay zero.
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float uv[2];
+  float colour[3];
+};
+
+// A vertex array over `vertices` with the attribute layout of the shaders.
+struct Drawable {
+  GlVertexArray vao;
+  GlBuffer buffer;
+  GLsizei count = 0;
+};
+
+Drawable Upload(const std::vector<Vertex>& vertices);
+
+// A vertex buffer drawn by index.
+struct IndexedMesh {
+  GlVertexArray vao;
+  GlBuffer positions, indices;  // `positions`: the vertex buffer (whole Vertex for the shaded mesh).
+  GLsizei count = 0;  // Indices.
+};
+
+// A textured mesh at one level of detail, in the three forms the passes draw.
+struct GpuMesh {
+  Drawable casters;       // Three vertices per triangle with face normals (planar shadows).
+  IndexedMesh positions;  // Positions alone, for depth-only passes.
+  IndexedMesh shaded;     // Position and atlas coordinate, for the eye's shaded passes.
+  GlTexture atlas;        // 0 without an atlas.
+  size_t triangles = 0;
+};
+
+// `ground` marks each caster triangle with its height above the ground (planar shadows).
+GpuMesh UploadMesh(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground);
+
+void SetTextureParameters(GLenum filter, GLenum wrap);
+
+// An sRGB texture of an image (values in [0, 1], sRGB-encoded), top row first; sampling returns
+// linear values.
+GlTexture UploadSrgbTexture(const Image& image);
+
+// A depth texture for hardware comparison, with an FBO that renders into it.
+struct DepthTarget {
+  GlTexture texture;
+  GlFramebuffer framebuffer;
+  int width = 0, height = 0;
+
+  void Resize(int new_width, int new_height);
+};
+
+// The frame: sRGB-encoded colour (RGBA8), auxiliary float RGBA, float depth + stencil.
+struct EyeTarget {
+  GlFramebuffer framebuffer;
+  GlTexture colour, aux;
+  GlRenderbuffer depth_stencil;
+  int width = 0, height = 0;
+
+  void Resize(int new_width, int new_height);
+};
+
+}  // namespace parallax::gpu
