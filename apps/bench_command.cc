@@ -78,6 +78,7 @@ class Bench {
   void StructureFromMotion();
   void Depth();
   void Render();
+  void Shadows();
   void LeaveOut();
 
   const fs::path& Out() const { return out_; }
@@ -148,6 +149,8 @@ void Bench::Depth() {
       {"best", "patchmatch", "quality=best sources=7", {"--quality", "best"}},
       {"balanced3", "patchmatch", "quality=balanced sources=3", {"--mvs-sources", "3"}},
       {"balanced7", "patchmatch", "quality=balanced sources=7", {"--mvs-sources", "7"}},
+      {"balanced_half", "patchmatch", "quality=balanced sources=5 scale=0.5", {"--mvs-scale", "0.5"}},
+      {"fast_half", "patchmatch", "quality=fast sources=3 scale=0.5", {"--quality", "fast", "--mvs-scale", "0.5"}},
       {"sgbm", "sgbm", "OpenCV StereoSGBM, rectified pairs", {"--stereo", "sgbm"}, true}};
   const int views = static_cast<int>(ReadSparseModel(scene_.Training().sparse).Images().size());
   for (const Setting& setting : settings) {
@@ -201,6 +204,42 @@ void Bench::Render() {
                      {"psnr_valid", At(json, "novel", "psnr_valid_mean")},
                      {"hole_ratio", At(json, "novel", "hole_ratio_mean")}},
                     At(json, "novel", "ms_per_view"), run.wall_s, run.peak_mb, setting.baseline});
+  }
+}
+
+// The number after `key` in a child's output (the first occurrence); throws when it is missing.
+double NumberAfter(const std::string& output, const std::string& key, const std::string& log) {
+  const size_t at = output.find(key);
+  if (at == std::string::npos) throw ToolError("bench: no '" + key + "' in the output of " + log);
+  return std::stod(output.substr(at + key.size()));
+}
+
+void Bench::Shadows() {
+  // The viewer on the balanced workspace's mesh (only the mesh stage runs: depth and fusion are
+  // done), from the 30 degree orbit at 1280x720; each frame's shadow mask against Embree's for
+  // the mesh it drew. Cast shadows alone rank the settings (see CompareCastShadows).
+  const fs::path workspace = out_ / "depth_balanced";
+  Parallax("shadows_mesh", {"reconstruct", Images().string(), workspace.string(), "--known-cameras",
+                            scene_.Training().sparse.string()});
+  fs::create_directories(out_ / "shadows");
+  for (const int size : {512, 1024, 2048, 4096}) {
+    for (const int radius : {0, 1, 2}) {
+      const std::string mode = radius == 0 ? "map" : "pcf";
+      const std::string id = mode + std::to_string(radius) + "_" + std::to_string(size);
+      const ChildRun run = Parallax(
+          "shadows_" + id, {"view", workspace.string(), "--screenshot", (out_ / "shadows" / (id + ".png")).string(),
+                            "--orbit", "30", "--no-cameras", "--no-grid", "--shadows", mode, "--shadow-map-size",
+                            std::to_string(size), "--pcf-radius", std::to_string(radius), "--shadow-iou",
+                            "--time-frames", "20"});
+      const std::string log = "shadows_" + id;
+      rows.push_back({"shadows", "parallax",
+                      mode + (radius > 0 ? " r=" + std::to_string(radius) : "") + " " + std::to_string(size) + "^2",
+                      {{"iou_cast", NumberAfter(run.output, "cast shadows alone: ", log)},
+                       {"iou", NumberAfter(run.output, "shadow IoU against Embree ray tracing: ", log)},
+                       {"ms_still_light", NumberAfter(run.output, "): median ", log)}},
+                      NumberAfter(run.output, "(shadow map re-rendered): median ", log), run.wall_s, run.peak_mb,
+                      false});
+    }
   }
 }
 
@@ -268,11 +307,13 @@ void RegisterBenchCommand(CLI::App& app) {
     bench.StructureFromMotion();
     bench.Depth();
     bench.Render();
+    bench.Shadows();
     bench.LeaveOut();
     const std::vector<BenchStage> stages = {
         {"sfm", "rotation_error_deg", "rotation error (deg)", false, "s"},
         {"depth", "within_2pct", "within 2% (share)", true, "s per view"},
-        {"render", "psnr", "PSNR (dB)", true, "ms per view"}};
+        {"render", "psnr", "PSNR (dB)", true, "ms per view"},
+        {"shadows", "iou_cast", "cast-shadow IoU vs Embree", true, "ms per frame, light moving"}};
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteBenchReport(bench.Out(), bench.rows, stages, DescribeMachine(), bench.leave_out, total);
     std::printf("bench: %zu runs in %.0f s -> %s (report.md, bench.csv, error_vs_time.png)\n",

@@ -119,7 +119,7 @@ const BenchRow* Recommended(const std::vector<const BenchRow*>& rows, const Benc
 std::string PlotScript(const fs::path& out_dir, const std::vector<BenchStage>& stages,
                        const std::vector<BenchRow>& rows) {
   std::ostringstream script;
-  script << "set terminal pngcairo size 1400,420 font 'sans,10'\n"
+  script << "set terminal pngcairo size " << 470 * stages.size() << ",420 font 'sans,10'\n"
          << "set output '" << (out_dir / "error_vs_time.png").string() << "'\n"
          << "set multiplot layout 1," << stages.size() << "\n"
          << "set logscale x\nset grid\nset key top outside horizontal center\nset offsets graph 0.05, graph 0.05, graph 0.08, graph 0.08\n"

@@ -94,6 +94,10 @@ void RegisterReconstructCommand(CLI::App& app) {
   command->add_option("--mvs-sources", arguments->options.mvs_sources,
                       "source views per depth map (default: as --quality says: 3, 5, 7)")
       ->check(CLI::Range(1, 32));
+  command->add_option("--mvs-scale", arguments->options.mvs_scale,
+                      "resolution of the depth estimate as a share of each photo side (default 1; "
+                      "0.5 is about 4x faster; depth maps are written at the photo's size)")
+      ->check(CLI::Range(0.25, 1.0));
   command->add_flag("--no-mesh", arguments->no_mesh,
                     "stop after depth maps and the fused cloud (no textured mesh)");
   command->add_flag("--strict", arguments->options.strict,

@@ -5,6 +5,8 @@
 #include <set>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "apps/commands.h"
 #include "apps/render_options.h"
 #include "apps/terminal_progress.h"
@@ -27,6 +29,13 @@ std::string CsvRow(const std::string& name, const NovelView& view) {
                 m.disocclusion_ratio, m.out_of_view_ratio, m.background_ratio, m.hole_count,
                 m.largest_hole_px, fill.c_str(), view.ms);
   return row;
+}
+
+// A stage of the request, as report.json lists it: run, or skipped and why.
+nlohmann::json Stage(const std::string& name, const std::string& skipped_because, const std::string& done = "") {
+  nlohmann::json stage = {{"name", name}, {"skipped", !skipped_because.empty()}};
+  stage["reason"] = skipped_because.empty() ? done : skipped_because;
+  return stage;
 }
 
 // A workspace made with `reconstruct --no-depth` (or missing some depth maps) gets depth for
@@ -72,7 +81,8 @@ void RegisterRenderCommand(CLI::App& app) {
       "render",
       "Render novel viewpoints by depth-image-based warping from the photos and depth maps of "
       "a workspace (its SfM frame) or a scene folder (its ground-truth cameras and depth). "
-      "Writes <name>.png, <name>.holes.png, <name>.depth.exr and render.csv.");
+      "Writes <name>.png, <name>.holes.png, <name>.depth.exr, render.csv and report.json (what was "
+      "computed and what was left out, and why).");
   command->add_option("input", arguments->input, "workspace or scene folder")->required();
   auto* cameras = command->add_option(
       "--cameras", arguments->cameras,
@@ -96,9 +106,22 @@ void RegisterRenderCommand(CLI::App& app) {
         arguments->cameras.empty()
             ? CamerasAlongPath(arguments->path, library.Cameras(), library.Names())
             : CamerasFromModel(arguments->cameras);
-    if (!std::filesystem::is_directory(arguments->input / "gt")) {
-      EstimateMissingDepth(arguments->input, library, targets, selection);
+    nlohmann::json stages = nlohmann::json::array();
+    if (std::filesystem::is_directory(arguments->input / "gt")) {
+      stages.push_back(Stage("depth", "a scene folder: its ground-truth depth maps are used"));
+    } else {
+      const std::vector<std::string> estimated = EstimateMissingDepth(arguments->input, library, targets, selection);
+      stages.push_back(estimated.empty()
+                           ? Stage("depth", "every source view these cameras use already has a depth map")
+                           : Stage("depth", "", "estimated for " + std::to_string(estimated.size()) + " of " +
+                                                    std::to_string(library.Cameras().size()) +
+                                                    " views: those these cameras use and had none"));
     }
+    // What `reconstruct` would also make, and a request for novel views alone does not need.
+    stages.push_back(Stage("fusion", "novel views warp each source's depth map; no fused cloud is needed"));
+    stages.push_back(Stage("mesh", "only novel views are requested: the Poisson mesh and its texture atlas "
+                                   "are for the viewer, and the warp does not use them"));
+    const size_t all_views = library.Cameras().size();
     for (const std::string& name : library.DropViewsWithoutDepth()) {
       std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
                    name.c_str());
@@ -107,6 +130,7 @@ void RegisterRenderCommand(CLI::App& app) {
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
         "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
     double hole_sum = 0, filled_sum = 0, ms_sum = 0;
+    std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.
     for (size_t i = 0; i < targets.size(); ++i) {
       const NovelView view =
           RenderNovelView(library, targets[i], selection, render_options);
@@ -115,16 +139,30 @@ void RegisterRenderCommand(CLI::App& app) {
       hole_sum += view.result.metrics.hole_ratio;
       filled_sum += view.result.fill.hole_ratio_filled;
       ms_sum += view.ms;
+      if (!view.result.fill.skipped.empty()) ++fill_skipped[view.result.fill.skipped];
       std::fprintf(stderr, "render %zu/%zu %s: %zu sources, holes %.2f%% -> %.2f%% filled, %.0f ms\n",
                    i + 1, targets.size(), targets[i].name.c_str(), view.sources.size(),
                    100 * view.result.metrics.hole_ratio, 100 * view.result.fill.hole_ratio_filled,
                    view.ms);
     }
     WriteFileAtomically(arguments->out / "render.csv", csv);
+    stages.push_back(Stage("sources", "", "loaded " + std::to_string(library.LoadedCount()) + " of " +
+                                              std::to_string(all_views) +
+                                              " source views: the others can not contribute to these cameras"));
+    std::string fill_skips;
+    size_t skipped_views = 0;
+    for (const auto& [reason, count] : fill_skipped) {
+      fill_skips += "; skipped for " + std::to_string(count) + ": " + reason;
+      skipped_views += count;
+    }
+    stages.push_back(Stage("fill", skipped_views == targets.size() ? fill_skips.substr(2) : "",
+                           "ran for " + std::to_string(targets.size() - skipped_views) + " of " +
+                               std::to_string(targets.size()) + " views" + fill_skips));
+    WriteFileAtomically(arguments->out / "report.json", nlohmann::json({{"render", {{"stages", stages}}}}).dump(2) + "\n");
     const double n = static_cast<double>(targets.size());
     std::printf("rendered %zu views from %d of %zu source views (the others were never loaded); "
                 "mean hole ratio %.2f%% before filling, %.2f%% after; %.1f ms per view -> %s\n",
-                targets.size(), library.LoadedCount(), library.Cameras().size(),
+                targets.size(), library.LoadedCount(), all_views,
                 100 * hole_sum / n, 100 * filled_sum / n, ms_sum / n, arguments->out.string().c_str());
   });
 }

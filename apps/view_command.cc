@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -16,6 +17,7 @@
 #include "core/image.h"
 #include "viewer/egl_context.h"
 #include "viewer/renderer.h"
+#include "viewer/shadow_reference.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 #include "viewer/viewer_scene.h"
@@ -40,6 +42,7 @@ struct ViewArguments {
   bool no_cameras = false;
   bool no_grid = false;
   int timed_frames = 0;  // Extra frames drawn after the screenshot to time the renderer.
+  bool shadow_iou = false;  // Compare the screenshot's shadows with Embree ray tracing.
 };
 
 std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
@@ -92,19 +95,57 @@ std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name
   return std::nullopt;
 }
 
-// Draws `frames` more frames of the same view, each finished with glFinish, and prints the
-// median and the fastest: the frame time of the interactive viewer holding still.
-void PrintFrameTimes(SceneRenderer& renderer, const ViewCamera& view, const FrameSettings& settings, int frames) {
+// The median and fastest of `frames` frames, each finished with glFinish; `before_frame(i)` may
+// change the settings first.
+template <typename BeforeFrame>
+std::pair<double, double> TimeFrames(SceneRenderer& renderer, const ViewCamera& view, FrameSettings settings,
+                                     int frames, const BeforeFrame& before_frame) {
   std::vector<double> ms;
   for (int i = 0; i < frames; ++i) {
+    before_frame(i, settings);
     const auto start = std::chrono::steady_clock::now();
     renderer.Draw(view, settings);
     renderer.Finish();
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
   std::sort(ms.begin(), ms.end());
+  return {ms[ms.size() / 2], ms[0]};
+}
+
+// Draws `frames` more frames of the same view and prints the median and the fastest: the frame
+// time of the interactive viewer holding still. With a shadow map, again with the light moving
+// a little every frame, so the map is re-rendered each time.
+void PrintFrameTimes(SceneRenderer& renderer, const ViewCamera& view, const FrameSettings& settings, int frames) {
+  const auto [median, fastest] = TimeFrames(renderer, view, settings, frames, [](int, FrameSettings&) {});
   std::printf("frame time over %d frames (%dx%d): median %.1f ms, min %.1f ms\n", frames,
-              static_cast<int>(view.camera.width), static_cast<int>(view.camera.height), ms[ms.size() / 2], ms[0]);
+              static_cast<int>(view.camera.width), static_cast<int>(view.camera.height), median, fastest);
+  if (settings.shadows != ShadowMode::kMap && settings.shadows != ShadowMode::kPcf) return;
+  const auto [moving, moving_fastest] = TimeFrames(renderer, view, settings, frames, [&](int i, FrameSettings& s) {
+    // A tenth of a degree back and forth about the up axis: a new map every frame.
+    const double angle = (i % 2 == 0 ? 1 : -1) * 0.1 * std::numbers::pi / 180;
+    if (s.light.type == LightKind::kPoint) {
+      s.light.position = settings.light.position + Eigen::Vector3d(0, 0, angle);
+    } else {
+      s.light.direction = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()) * settings.light.direction;
+    }
+  });
+  std::printf("frame time with the light moving (shadow map re-rendered): median %.1f ms, min %.1f ms\n", moving,
+              moving_fastest);
+}
+
+// The frame's shadow mask against Embree's exact one for the mesh it drew.
+void PrintShadowAccuracy(const TexturedMesh& drawn, const ViewCamera& view, const FrameSettings& settings,
+                         const FrameResult& frame) {
+  if (settings.light.type != LightKind::kDirectional || drawn.triangles.empty()) {
+    throw BadInputError("--shadow-iou needs a directional light and a mesh");
+  }
+  const std::vector<ReferencePixel> reference = ReferenceShadows(drawn, view, settings.light.direction);
+  const MaskComparison mask = CompareShadowMasks(reference, frame.aux);
+  const MaskComparison cast = CompareCastShadows(reference, frame.aux);
+  std::printf("shadow IoU against Embree ray tracing: %.4f (%d rendered, %d ray-traced shadowed of %d pixels); "
+              "cast shadows alone: %.4f (%d / %d of %d pixels facing the light)\n",
+              mask.iou, mask.rendered_shadowed, mask.reference_shadowed, mask.compared, cast.iou,
+              cast.rendered_shadowed, cast.reference_shadowed, cast.compared);
 }
 
 void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const FrameSettings& settings) {
@@ -127,6 +168,12 @@ void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fram
   WriteImage(a.screenshot, result.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
   std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), result.colour.Width(),
               result.colour.Height(), ms);
+  const TexturedMesh& drawn = DisplayedMesh(scene, result.colour.Width(), result.colour.Height());
+  if (&drawn == &scene.display_mesh) {
+    std::printf("level of detail: the display mesh, %zu of %zu triangles\n", drawn.triangles.size(),
+                scene.mesh.triangles.size());
+  }
+  if (a.shadow_iou) PrintShadowAccuracy(drawn, view, settings, result);
   if (a.timed_frames > 0) PrintFrameTimes(renderer, view, settings, a.timed_frames);
 }
 
@@ -172,6 +219,9 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_option("--time-frames", a->timed_frames,
                       "with --screenshot: draw this many more frames and print the median frame time")
       ->check(CLI::Range(1, 10000));
+  command->add_flag("--shadow-iou", a->shadow_iou,
+                    "with --screenshot: compare its shadow mask with one ray-traced by Embree for the same "
+                    "mesh and light, and print the intersection over union");
   command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {

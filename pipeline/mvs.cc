@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <map>
 #include <set>
@@ -10,6 +11,8 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+
+#include <opencv2/imgproc.hpp>
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -26,6 +29,48 @@ GrayImage LoadGray(const fs::path& path) {
                                    : pixel[0];
   }
   return gray;
+}
+
+// The photo at `scale` of its size (area averaging, no aliasing), with its camera to match:
+// pixel coordinates (origin at the image corner) scale by the exact size ratio per axis.
+void ScaleView(StereoView& view, double scale) {
+  if (scale == 1) return;
+  const int width = std::max(1, static_cast<int>(std::lround(view.image.width * scale)));
+  const int height = std::max(1, static_cast<int>(std::lround(view.image.height * scale)));
+  const cv::Mat full(view.image.height, view.image.width, CV_32F, view.image.values.data());
+  cv::Mat small;
+  cv::resize(full, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  view.image = {width, height, std::vector<float>(small.begin<float>(), small.end<float>())};
+  const double sx = static_cast<double>(width) / static_cast<double>(view.camera.width);
+  const double sy = static_cast<double>(height) / static_cast<double>(view.camera.height);
+  view.camera = MakePinholeCamera(view.camera.id, static_cast<uint64_t>(width), static_cast<uint64_t>(height),
+                                  view.camera.FocalX() * sx, view.camera.FocalY() * sy,
+                                  view.camera.PrincipalX() * sx, view.camera.PrincipalY() * sy);
+}
+
+// Back to the photo's size: each pixel takes the estimate of the low-resolution pixel its
+// centre falls in.
+DepthNormalMap UpsampleNearest(const DepthNormalMap& estimate, int width, int height) {
+  const int low_width = estimate.depth.Width(), low_height = estimate.depth.Height();
+  if (low_width == width && low_height == height) return estimate;
+  DepthNormalMap full{DepthMap(width, height), std::vector<float>(static_cast<size_t>(width) * height * 3),
+                      std::vector<float>(static_cast<size_t>(width) * height)};
+  for (int y = 0; y < height; ++y) {
+    const int ly = std::min(low_height - 1, static_cast<int>((y + 0.5) * low_height / height));
+    for (int x = 0; x < width; ++x) {
+      const int lx = std::min(low_width - 1, static_cast<int>((x + 0.5) * low_width / width));
+      const size_t low = static_cast<size_t>(ly) * low_width + lx, high = static_cast<size_t>(y) * width + x;
+      full.depth.At(x, y) = estimate.depth.At(lx, ly);
+      if (!estimate.cost.empty()) full.cost[high] = estimate.cost[low];
+      for (int c = 0; c < 3; ++c) full.normal[3 * high + c] = estimate.normal[3 * low + c];
+    }
+  }
+  return full;
+}
+
+DepthMap UpsampleNearest(const DepthMap& depth, int width, int height) {
+  return UpsampleNearest(DepthNormalMap{depth, std::vector<float>(depth.Values().size() * 3), {}}, width, height)
+      .depth;
 }
 
 double Seconds(std::chrono::steady_clock::time_point start) {
@@ -57,6 +102,9 @@ void MvsOptions::Check() const {
   patch_match.Check();
   filter.Check();
   if (filter_sources < 1) throw std::invalid_argument("MvsOptions: filter_sources must be >= 1");
+  if (!(image_scale >= 0.25 && image_scale <= 1)) {
+    throw std::invalid_argument("MvsOptions: image_scale must be in [0.25, 1]");
+  }
 }
 
 MvsOptions MvsOptionsFor(Quality quality) {
@@ -139,6 +187,7 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
     view.camera = model.CameraById(image.camera_id);
     view.cam_from_world = image.cam_from_world;
     view.image = LoadGray(workspace / "images" / image.name);
+    ScaleView(view, options.image_scale);
   }
 
   auto start = std::chrono::steady_clock::now();
@@ -167,11 +216,17 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
     for (uint32_t id : plan.sources) {
       if (estimates.count(id)) sources.emplace_back(&views.at(id), &estimates.at(id));
     }
-    const DepthNormalMap& estimate = estimates.at(plan.image_id);
-    const FilteredDepth filtered =
-        sources.empty() ? FilteredDepth{DepthMap(estimate.depth.Width(), estimate.depth.Height()),
-                                        DepthMap(estimate.depth.Width(), estimate.depth.Height())}
-                        : FilterGeometric(views.at(plan.image_id), estimate, sources, options.filter);
+    const DepthNormalMap& low = estimates.at(plan.image_id);
+    FilteredDepth filtered =
+        sources.empty() ? FilteredDepth{DepthMap(low.depth.Width(), low.depth.Height()),
+                                        DepthMap(low.depth.Width(), low.depth.Height())}
+                        : FilterGeometric(views.at(plan.image_id), low, sources, options.filter);
+    // Every file at the photo's size, whatever the resolution of the estimate.
+    const Camera& camera = model.CameraById(model.ImageById(plan.image_id).camera_id);
+    const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+    const DepthNormalMap estimate = UpsampleNearest(low, width, height);
+    filtered.depth = UpsampleNearest(filtered.depth, width, height);
+    filtered.confidence = UpsampleNearest(filtered.confidence, width, height);
 
     const std::string stem = fs::path(plan.name).stem().string();
     WriteColmapDepth(stereo / "depth_maps" / (plan.name + ".photometric.bin"),

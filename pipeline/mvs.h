@@ -24,6 +24,10 @@ struct MvsOptions {
   // the geometric filter checks each depth against its sources' estimates.
   std::vector<std::string> only_views;
   int filter_sources = 2;
+  // Resolution of the estimate, as a share of each side (0.25..1): the photos are resampled to
+  // it, and the depth maps upsampled back (nearest, never blending depths across an edge) so
+  // every file keeps the photo's size. Half resolution is about 4x faster.
+  double image_scale = 1;
   void Check() const;
 };
 

@@ -111,28 +111,42 @@ std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
   return hits;
 }
 
+namespace {
+
+// Whether each of `count` segments (ray i from make_segment(i), t in [0, tfar]) is free of the
+// mesh, in batches over all threads.
+template <typename MakeSegment>
+std::vector<uint8_t> FreeSegments(RTCScene scene, size_t count, const MakeSegment& make_segment) {
+  std::vector<uint8_t> free(count, 0);
+  constexpr size_t kBatch = 1024;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kBatch), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<RTCRay> rays(range.size());
+    for (size_t i = range.begin(); i < range.end(); ++i) rays[i - range.begin()] = make_segment(i);
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rtcOccluded1M(scene, &context, rays.data(), static_cast<unsigned>(rays.size()), sizeof(RTCRay));
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      // rtcOccluded sets tfar to -inf when something blocks the segment.
+      free[i] = rays[i - range.begin()].tfar >= 0 ? 1 : 0;
+    }
+  });
+  return free;
+}
+
+}  // namespace
+
 std::vector<uint8_t> MeshRaycaster::Visible(const Eigen::Vector3f& eye,
                                             const std::vector<Eigen::Vector3f>& points,
                                             float tolerance) const {
-  std::vector<uint8_t> visible(points.size(), 0);
-  constexpr size_t kBatch = 1024;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, points.size(), kBatch),
-                    [&](const tbb::blocked_range<size_t>& range) {
-    std::vector<RTCRay> rays(range.size());
-    for (size_t i = range.begin(); i < range.end(); ++i) {
-      // Direction = the whole segment, so t runs from 0 (eye) to 1 (point).
-      rays[i - range.begin()] = MakeRay(eye, points[i] - eye, 1.0f - tolerance);
-    }
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    rtcOccluded1M(impl_->scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
-                  sizeof(RTCRay));
-    for (size_t i = range.begin(); i < range.end(); ++i) {
-      // rtcOccluded sets tfar to -inf when something blocks the segment.
-      visible[i] = rays[i - range.begin()].tfar >= 0 ? 1 : 0;
-    }
-  });
-  return visible;
+  // Direction = the whole segment, so t runs from 0 (eye) to 1 (point).
+  return FreeSegments(impl_->scene, points.size(),
+                      [&](size_t i) { return MakeRay(eye, points[i] - eye, 1.0f - tolerance); });
+}
+
+std::vector<uint8_t> MeshRaycaster::Unoccluded(const std::vector<Eigen::Vector3f>& origins,
+                                               const Eigen::Vector3f& direction, float length) const {
+  const Eigen::Vector3f unit = direction.normalized();
+  return FreeSegments(impl_->scene, origins.size(), [&](size_t i) { return MakeRay(origins[i], unit, length); });
 }
 
 }  // namespace parallax

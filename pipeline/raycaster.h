@@ -38,6 +38,11 @@ class MeshRaycaster {
                                const std::vector<Eigen::Vector3f>& points,
                                float tolerance) const;
 
+  // For each origin, whether the segment from it along `direction` for `length` is free (a
+  // shadow ray towards a directional light). All threads.
+  std::vector<uint8_t> Unoccluded(const std::vector<Eigen::Vector3f>& origins,
+                                  const Eigen::Vector3f& direction, float length) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

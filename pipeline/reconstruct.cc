@@ -417,6 +417,7 @@ void ReconstructOptions::Check() const {
   if (!(max_refined_principal_point_offset > 0)) {
     throw std::invalid_argument("max_refined_principal_point_offset must be > 0");
   }
+  if (!(mvs_scale >= 0.25 && mvs_scale <= 1)) throw std::invalid_argument("mvs_scale must be in [0.25, 1]");
   plausibility.Check();
 }
 
@@ -667,11 +668,13 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                                       .Add(static_cast<uint64_t>(options.quality))
                                       .Add(static_cast<uint64_t>(options.stereo))
                                       .Add(static_cast<uint64_t>(options.mvs_sources))
+                                      .Add(options.mvs_scale == 1 ? "" : "scale " + std::to_string(options.mvs_scale))
                                       .Hex();
     const fs::path views_file = workspace / "depth" / "views.json";
     stages.Run("depth", depth_key, views_file, [&] {
       MvsOptions mvs_options = MvsOptionsFor(options.quality);
       if (options.mvs_sources > 0) mvs_options.views.max_sources = options.mvs_sources;
+      mvs_options.image_scale = options.mvs_scale;
       const MvsSummary mvs =
           options.stereo == StereoMethod::kSgbm
               ? RunSgbmStereo(workspace, mvs_options.views, {}, progress)

@@ -63,6 +63,8 @@ struct ReconstructOptions {
   StereoMethod stereo = StereoMethod::kPatchMatch;
   // Source views per depth map; 0 = as `quality` says.
   int mvs_sources = 0;
+  // Resolution of the depth estimate as a share of each photo side (MvsOptions::image_scale).
+  double mvs_scale = 1;
   // After depth: Poisson mesh, trimmed and textured (pipeline/mesh.h).
   bool build_mesh = true;
   void Check() const;  // Throws std::invalid_argument naming the field.

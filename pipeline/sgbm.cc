@@ -81,6 +81,34 @@ void DisparityRange(const RectifiedPair& pair, double min_depth, double max_dept
   num_disparities = std::clamp((high - min_disparity + 15) / 16 * 16, 16, kMaxDisparities);
 }
 
+// Windows whose grey levels vary less than this (standard deviation, 8-bit levels) are
+// textureless: PatchMatch's min_texture_std of 0.004, in 8-bit units.
+constexpr double kMinTextureStdLevels = 0.004 * 255;
+
+// Where a disparity of the rectified left image can be trusted: its block_size window lies
+// inside the photo and is textured. StereoSGBM itself claims a disparity for flat windows
+// (their matching cost is 0 at every disparity, which its uniqueness test does not reject,
+// so a constant photo comes back at the minimum disparity everywhere), and windows that
+// straddle the photo's edge match the edge of the frame, not the scene.
+cv::Mat MatchableMask(const cv::Mat& left, const cv::Mat& map_x, const cv::Mat& map_y,
+                      const cv::Size& photo_size, int block_size) {
+  const cv::Mat photo(photo_size, CV_8U, cv::Scalar(255));
+  cv::Mat inside;
+  cv::remap(photo, inside, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  const cv::Size window(block_size, block_size);
+  cv::erode(inside, inside, cv::getStructuringElement(cv::MORPH_RECT, window), cv::Point(-1, -1),
+            1, cv::BORDER_CONSTANT, 0);
+  // Grey levels up to 255 in float: E[I^2] - E[I]^2 keeps ~0.01 levels^2, against a
+  // threshold of ~1.
+  cv::Mat grey, mean, mean_square;
+  left.convertTo(grey, CV_32F);
+  cv::boxFilter(grey, mean, CV_32F, window);
+  cv::boxFilter(grey.mul(grey), mean_square, CV_32F, window);
+  const cv::Mat variance = mean_square - mean.mul(mean);
+  const cv::Mat textured = variance >= kMinTextureStdLevels * kMinTextureStdLevels;
+  return inside & textured;
+}
+
 DepthMap DepthFromDisparity(const cv::Mat& disparity16, const RectifiedPair& pair,
                             const Camera& camera, int min_disparity) {
   cv::Mat disparity;
@@ -145,6 +173,8 @@ MvsSummary RunSgbmStereo(const fs::path& workspace, const ViewSelectionOptions& 
     cv::initUndistortRectifyMap(IntrinsicMatrix(camera), cv::noArray(), pair->r1, pair->p1, size,
                                 CV_32FC1, map_x, map_y);
     cv::remap(LoadGray8(workspace / "images" / reference.name), left, map_x, map_y, cv::INTER_LINEAR);
+    const cv::Size photo_size(static_cast<int>(camera.width), static_cast<int>(camera.height));
+    const cv::Mat matchable = MatchableMask(left, map_x, map_y, photo_size, options.block_size);
     const Camera& source_camera = model.CameraById(source->camera_id);
     cv::initUndistortRectifyMap(IntrinsicMatrix(source_camera), cv::noArray(), pair->r2, pair->p2,
                                 size, CV_32FC1, map_x, map_y);
@@ -164,7 +194,9 @@ MvsSummary RunSgbmStereo(const fs::path& workspace, const ViewSelectionOptions& 
     cv::copyMakeBorder(right, right, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
     cv::Mat padded_disparity;
     sgbm->compute(left, right, padded_disparity);
-    const cv::Mat disparity = padded_disparity.colRange(pad, padded_disparity.cols);
+    cv::Mat disparity = padded_disparity.colRange(pad, padded_disparity.cols);
+    // StereoSGBM's "no disparity" value.
+    disparity.setTo(cv::Scalar((min_disparity - 1) * 16), ~matchable);
     const DepthMap depth = DepthFromDisparity(disparity, *pair, camera, min_disparity);
     DepthMap confidence(depth.Width(), depth.Height());
     for (size_t p = 0; p < depth.Values().size(); ++p) {

@@ -22,6 +22,9 @@ struct SgbmOptions {
 // Writes <ws>/depth/<stem>.exr and <stem>.confidence.exr (1 where SGBM found a disparity) for
 // every view with a usable pair; no normal maps (so fusion leaves SGBM views out). The plans
 // (sources, depth ranges) come from the same view selection as multi-view stereo.
+// Textureless windows (grey-level std below 0.004, PatchMatch's threshold) and windows that
+// straddle the photo's edge get no depth: StereoSGBM alone would claim its minimum disparity
+// all over a constant photo.
 MvsSummary RunSgbmStereo(const std::filesystem::path& workspace, const ViewSelectionOptions& views,
                          const SgbmOptions& options, Progress& progress);
 

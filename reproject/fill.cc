@@ -188,6 +188,8 @@ FillSummary FillHoles(const ClassMap& classes, const FillOptions& options, Blend
   }
   if (empty == 0) {
     summary.skipped = "no holes to fill";
+  } else if (options.method == FillMethod::kNone) {
+    summary.skipped = "not requested (fill none)";
   } else if (options.method == FillMethod::kDepthAware) {
     summary.filled_px = FillDepthAware(classes, options, blend);
   } else if (options.method == FillMethod::kInpaint) {

@@ -97,13 +97,17 @@ PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir, double
 // Whether the ray is a hole between inverse depths inv_near >= inv_far: a sampled point
 // inside some source and seen as empty space by none (the ray reaches something hidden)
 // beyond a point some source sees as empty space (the ray passed into the sources' view in
-// the open), or a point some source saw without knowing its depth. A ray whose first points in any view are already hidden runs under a surface no
-// source saw, from outside every view: the ground below the sources' frames, not a hole.
-// Sampling starts at half the near depth, so a surface at the near end counts.
+// the open), or a point some source saw without knowing its depth. A ray whose first points
+// in any view are already hidden runs under a surface no source saw, from outside every view:
+// the ground below the sources' frames, not a hole. Sampling starts at half the near depth,
+// so a surface at the near end counts, or at half `inv_nearest` (the nearest surface anywhere
+// in the target) where that is nearer: an occluder outside the nearby rows' depth range (a
+// disocclusion strip taller than depth_range_rows under a much nearer surface) must still be
+// passed in free space.
 bool RayIsHole(const std::vector<SourceFrustum>& sources, const std::vector<Eigen::Vector3d>& dirs,
-               double inv_near, double inv_far, const HoleOptions& options) {
+               double inv_nearest, double inv_near, double inv_far, const HoleOptions& options) {
   const int samples = inv_near > inv_far ? options.free_space_samples : 1;
-  const double inv_start = samples == 1 ? inv_near : 2 * inv_near;
+  const double inv_start = samples == 1 ? inv_near : 2 * std::max(inv_near, inv_nearest);
   bool passed_free = samples == 1;
   for (int k = 0; k < samples; ++k) {
     const double inv_depth =
@@ -243,6 +247,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
   const std::vector<DepthRange> rows = RowDepthRanges(blend);
   DepthRange global;
   for (const DepthRange& row : rows) global.Merge(row);
+  const double inv_nearest = global.HasSurface() ? 1 / global.near : 0;
 
   ClassMap map{width, height, std::vector<PixelClass>(blend.kind.size())};
   std::vector<uint8_t> hole(blend.kind.size(), 0);
@@ -282,7 +287,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
         inv_far = std::min(inv_far, std::isinf(hi) ? 0.0 : 1 / hi);
       }
       if (in_view && all_depth) {
-        in_view = RayIsHole(frustums, dirs, inv_near, inv_far, options);
+        in_view = RayIsHole(frustums, dirs, inv_nearest, inv_near, inv_far, options);
       }
       map.classes[i] = in_view ? PixelClass::kDisocclusion : PixelClass::kOutOfView;
       hole[i] = in_view ? 1 : 0;

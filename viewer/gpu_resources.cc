@@ -89,24 +89,25 @@ std::vector<Eigen::Vector3f> CornerNormals(const TexturedMesh& mesh) {
   return normals;
 }
 
-// The mesh for the eye's shaded pass: a vertex per distinct (position, atlas coordinate), drawn
-// by index, so triangles inside an atlas chart share their corners and llvmpipe shades fewer
-// vertices. Normals are per corner (CornerNormals); a shared corner takes its first triangle's.
+// The mesh for the eye's shaded pass: a vertex per distinct (position, atlas coordinate, corner
+// normal), drawn by index, so triangles inside an atlas chart and a smooth patch share their
+// corners and llvmpipe shades fewer vertices.
 IndexedMesh UploadShadedMesh(const TexturedMesh& mesh) {
   const std::vector<Eigen::Vector3f> normals = CornerNormals(mesh);
   std::vector<Vertex> vertices;
   std::vector<GLuint> indices;
   indices.reserve(mesh.triangles.size() * 3);
   const bool has_uv = mesh.corner_uvs.size() == mesh.triangles.size() * 3;
-  std::map<std::tuple<int, float, float>, GLuint> index_of;
+  std::map<std::tuple<int, float, float, float, float, float>, GLuint> index_of;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     for (int c = 0; c < 3; ++c) {
       const int v = mesh.triangles[t][c];
       const Eigen::Vector2f uv = has_uv ? mesh.corner_uvs[3 * t + c] : Eigen::Vector2f(0.5f, 0.5f);
-      const auto [found, inserted] = index_of.try_emplace({v, uv.x(), uv.y()}, static_cast<GLuint>(vertices.size()));
+      const Eigen::Vector3f& n = normals[3 * t + c];
+      const auto [found, inserted] =
+          index_of.try_emplace({v, uv.x(), uv.y(), n.x(), n.y(), n.z()}, static_cast<GLuint>(vertices.size()));
       if (inserted) {
         const Eigen::Vector3f& p = mesh.vertices[v];
-        const Eigen::Vector3f& n = normals[3 * t + c];
         vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, {uv.x(), 1 - uv.y()}, {0, 0, 0}});
       }
       indices.push_back(found->second);

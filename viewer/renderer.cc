@@ -26,10 +26,6 @@ using gpu::Vertex;
 using gpu::kAtlasUnit, gpu::kShadowUnit, gpu::kPhotoUnit, gpu::kProjectorDepthUnit;
 
 constexpr int kMaxProjectors = 3;
-// The display mesh (a simplified copy, when the workspace has one) is drawn when the full mesh
-// would give a triangle to fewer pixels than this: finer triangles cost llvmpipe vertex and
-// setup work without adding detail the atlas does not already show.
-constexpr int kPixelsPerTriangle = 16;
 
 bool HasExtension(std::string_view name) {
   GLint count = 0;
@@ -175,6 +171,12 @@ void FrameSettings::Check() const {
     fail("light.direction (finite, non-zero)", "");
   }
   if (!light.position.allFinite()) fail("light.position (finite)", "");
+}
+
+const TexturedMesh& DisplayedMesh(const ViewerScene& scene, int width, int height) {
+  constexpr size_t kPixelsPerTriangle = 16;
+  const bool too_fine = scene.mesh.triangles.size() * kPixelsPerTriangle > static_cast<size_t>(width) * static_cast<size_t>(height);
+  return too_fine && !scene.display_mesh.triangles.empty() ? scene.display_mesh : scene.mesh;
 }
 
 std::vector<int> NearestSourceViews(const ViewerScene& scene, const Eigen::Vector3d& eye, int count) {
@@ -503,8 +505,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   const bool reverse_z = r.reverse_z && settings.reverse_z;
   r.reverse_z_now = reverse_z;
   const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
-  const bool too_fine = r.full_mesh.triangles * kPixelsPerTriangle > static_cast<size_t>(width) * height;
-  r.mesh = r.display_mesh.triangles > 0 && too_fine ? &r.display_mesh : &r.full_mesh;
+  r.mesh = &DisplayedMesh(r.scene, width, height) == &r.scene.display_mesh ? &r.display_mesh : &r.full_mesh;
 
   // 1. Shadow map from the light.
   int shadow_mode_uniform = 0;

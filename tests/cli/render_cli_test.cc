@@ -1,9 +1,11 @@
 // `parallax render` through the real executable: outputs, the leave-out of depth estimation,
 // and its error paths.
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
@@ -66,6 +68,17 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_GE(maps, 2u);
   EXPECT_LE(maps, 4u) << "only the sources of two frames between 0003 and 0005";
   EXPECT_TRUE(fs::exists(dir.Path() / "out" / "between_0001.png"));
+  // report.json says what ran and what was left out, and why: no fused cloud, no mesh or atlas.
+  const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(dir.Path() / "out" / "report.json"));
+  std::map<std::string, nlohmann::json> stages;
+  for (const nlohmann::json& stage : report.at("render").at("stages")) stages[stage.at("name")] = stage;
+  EXPECT_FALSE(stages.at("depth").at("skipped").get<bool>());
+  EXPECT_NE(stages.at("depth").at("reason").get<std::string>().find(" of 12 views"), std::string::npos);
+  EXPECT_TRUE(stages.at("fusion").at("skipped").get<bool>());
+  EXPECT_TRUE(stages.at("mesh").at("skipped").get<bool>());
+  EXPECT_NE(stages.at("mesh").at("reason").get<std::string>().find("texture atlas"), std::string::npos);
+  EXPECT_NE(stages.at("sources").at("reason").get<std::string>().find(" of 12 source views"), std::string::npos);
+  EXPECT_FALSE(fs::exists(workspace / "mesh")) << "the atlas is never made for novel views";
 }
 
 TEST(RenderCli, BadInputExitsTwoAndNamesTheProblem) {

@@ -92,10 +92,13 @@ TEST(Render, FillingIsSkippedWhenNothingIsMissing) {
   EXPECT_EQ(same.metrics.hole_ratio + same.metrics.out_of_view_ratio, 0.0);
   EXPECT_EQ(same.fill.skipped, "no holes to fill");
   EXPECT_EQ(same.fill.filled_px, 0);
-  // Moved sideways: an out-of-view strip to fill, so filling runs.
-  const RenderResult moved = Render({&source}, CameraAt(camera, {0.3, 0, 0}), Options(WarpMethod::kMesh));
+  // Moved sideways: an out-of-view strip to fill, so filling runs, unless none was asked for.
+  const PosedCamera target = CameraAt(camera, {0.3, 0, 0});
+  const RenderResult moved = Render({&source}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
   EXPECT_GT(moved.metrics.out_of_view_ratio, 0.05);
   EXPECT_TRUE(moved.fill.skipped.empty());
+  EXPECT_GT(moved.fill.filled_px, 0);
+  EXPECT_EQ(Render({&source}, target, Options(WarpMethod::kMesh)).fill.skipped, "not requested (fill none)");
 }
 
 TEST(Render, BoxInFrontOfWallDisocclusionMatchesRayCasting) {

@@ -40,14 +40,14 @@ TEST(ViewerShadows, ShadowMapMatchesRayTracedMask) {
   ASSERT_TRUE(scene.ground.has_value());
   SceneRenderer renderer(scene);
   const ViewCamera view = TestView(scene);
-  const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, kLight);
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, kLight);
   for (const auto& [mode, min_iou, name] : {std::tuple{ShadowMode::kMap, 0.95, "map"},
                                             std::tuple{ShadowMode::kPcf, 0.90, "pcf"}}) {
     const FrameResult result = renderer.Render(view, ShadowSettings(mode, kLight));
     MaybeSave(std::string("shadow_") + name, result);
-    const MaskComparison all = CompareMasks(reference, result.aux, [](const ReferencePixel&) { return true; });
+    const MaskComparison all = CompareShadowMasks(reference, result.aux);
     // Cast shadows alone (the ground), without the box's faces turned away from the light.
-    const MaskComparison ground = CompareMasks(reference, result.aux,
+    const MaskComparison ground = CompareShadowMasks(reference, result.aux,
                                                [](const ReferencePixel& p) { return std::abs(p.point.z()) < 1e-3; });
     std::printf("[ measure ] %s: IoU %.4f (ground only %.4f) over %d pixels, shadowed ref %d / rendered %d\n",
                 name, all.iou, ground.iou, all.compared, all.reference_shadowed, all.rendered_shadowed);
@@ -62,10 +62,10 @@ TEST(ViewerShadows, PlanarShadowsMatchRayTracedMaskOnTheGround) {
   const ViewerScene scene = BoxOnGround();
   SceneRenderer renderer(scene);
   const ViewCamera view = TestView(scene);
-  const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, kLight);
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, kLight);
   const FrameResult result = renderer.Render(view, ShadowSettings(ShadowMode::kPlanar, kLight));
   MaybeSave("shadow_planar", result);
-  const MaskComparison ground = CompareMasks(reference, result.aux,
+  const MaskComparison ground = CompareShadowMasks(reference, result.aux,
                                              [](const ReferencePixel& p) { return std::abs(p.point.z()) < 1e-3; });
   std::printf("[ measure ] planar: ground IoU %.4f over %d pixels\n", ground.iou, ground.compared);
   EXPECT_GE(ground.iou, 0.95);
@@ -191,7 +191,7 @@ TEST(ViewerShadows, GrazingLightGivesNoNanAndNoFullScreenAcne) {
   const Eigen::Vector2d across = Eigen::Vector2d(1, 0.3).normalized();
   const Eigen::Vector3d light = -Eigen::Vector3d(std::cos(elevation) * across.x(),
                                                  std::cos(elevation) * across.y(), std::sin(elevation));
-  const std::vector<ReferencePixel> reference = ReferenceShadows(scene, view, light);
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, light);
   for (ShadowMode mode : {ShadowMode::kMap, ShadowMode::kPcf, ShadowMode::kPlanar}) {
     const FrameResult result = renderer.Render(view, ShadowSettings(mode, light));
     for (float v : result.colour.Pixels()) ASSERT_TRUE(std::isfinite(v));

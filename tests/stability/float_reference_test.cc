@@ -1,0 +1,497 @@
+// The float paths of numerically sensitive routines against double references on random
+// inputs (issue: numerical stability). Each test reports its worst error (a printed line and
+// a RecordProperty in the XML) and asserts it under a bound stated as float roundings times
+// the condition number of the computation.
+//
+// kEps below is float's machine epsilon (2^-23): one rounding moves a value by at most
+// kEps / 2 relative.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/patch_match.h"
+#include "reproject/forward_warp.h"
+#include "viewer/view_math.h"
+
+namespace parallax {
+namespace {
+
+constexpr double kEps = std::numeric_limits<float>::epsilon();
+
+// Prints the worst error (and its bound, where one is asserted) and records it in the XML.
+void Report(const std::string& name, double worst, double bound) {
+  if (bound > 0) {
+    std::printf("[ stability ] %s: worst %.3g, bound %.3g\n", name.c_str(), worst, bound);
+  } else {
+    std::printf("[ stability ] %s: worst %.3g\n", name.c_str(), worst);
+  }
+  testing::Test::RecordProperty(name, std::to_string(worst));
+}
+
+// ---- PatchMatch's bilaterally weighted NCC (WindowCost, float) ---------------------------
+
+// A smooth random texture of mean `mean` and contrast `contrast`.
+GrayImage RandomWindowImage(int size, double mean, double contrast, std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  double kx[4], ky[4], phase[4];
+  for (int k = 0; k < 4; ++k) {
+    const double wavelength = 3 + 9 * unit(random), angle = 2 * std::numbers::pi * unit(random);
+    kx[k] = 2 * std::numbers::pi / wavelength * std::cos(angle);
+    ky[k] = 2 * std::numbers::pi / wavelength * std::sin(angle);
+    phase[k] = 2 * std::numbers::pi * unit(random);
+  }
+  GrayImage image{size, size, {}};
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      double value = 0;
+      for (int k = 0; k < 4; ++k) value += std::sin(kx[k] * x + ky[k] * y + phase[k]);
+      image.values.push_back(static_cast<float>(std::clamp(mean + contrast * value / 2, 0.0, 1.0)));
+    }
+  }
+  return image;
+}
+
+double Bilinear(const GrayImage& image, double u, double v) {
+  const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+  const double ax = u - x0, ay = v - y0;
+  const auto at = [&](int x, int y) { return static_cast<double>(image.At(x, y)); };
+  return (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) +
+         ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1));
+}
+
+// WindowCost in double with two-pass (centred) moments, which do not cancel. `kappa` gets
+// the condition number of the float formulas, E[I^2] - E[I]^2 style: (mean^2 + var) / var of
+// the worse of the two windows. `near_threshold` is set where a float rounding could flip one
+// of WindowCost's decisions (textured or not, inside the image or not): those samples are
+// not comparable.
+double ReferenceCost(const GrayImage& reference, int x, int y, const GrayImage& source,
+                     const Eigen::Matrix3d& h, const PatchMatchOptions& options, double* kappa,
+                     bool* near_threshold) {
+  struct Sample {
+    double weight, i, j;
+  };
+  std::vector<Sample> samples;
+  const double sigma_spatial = static_cast<double>(options.sigma_spatial_px);
+  const double sigma_color = static_cast<double>(options.sigma_color);
+  const double min_std = static_cast<double>(options.min_texture_std);
+  const double centre = static_cast<double>(reference.At(x, y));
+  double weight_sum = 0;
+  *near_threshold = false;
+  for (int dy = -options.window_radius; dy <= options.window_radius; dy += options.window_step) {
+    for (int dx = -options.window_radius; dx <= options.window_radius; dx += options.window_step) {
+      const double i = static_cast<double>(reference.At(
+          std::clamp(x + dx, 0, reference.width - 1), std::clamp(y + dy, 0, reference.height - 1)));
+      const double weight =
+          std::exp(-(dx * dx + dy * dy) / (2 * sigma_spatial * sigma_spatial)) *
+          std::exp(-(i - centre) * (i - centre) / (2 * sigma_color * sigma_color));
+      const Eigen::Vector3d p = h * Eigen::Vector3d(x + 0.5 + dx, y + 0.5 + dy, 1);
+      const double u = p.x() / p.z() - 0.5, v = p.y() / p.z() - 0.5;
+      const double max_u = source.width - 1, max_v = source.height - 1;
+      if (std::min({u, v, max_u - u, max_v - v}) < 1e-3) *near_threshold = true;
+      if (!(u >= 0 && v >= 0 && u < max_u && v < max_v)) return 2;
+      samples.push_back({weight, i, Bilinear(source, u, v)});
+      weight_sum += weight;
+    }
+  }
+  double mean_i = 0, mean_j = 0;
+  for (Sample& s : samples) {
+    s.weight /= weight_sum;
+    mean_i += s.weight * s.i;
+    mean_j += s.weight * s.j;
+  }
+  double var_i = 0, var_j = 0, covariance = 0;
+  for (const Sample& s : samples) {
+    var_i += s.weight * (s.i - mean_i) * (s.i - mean_i);
+    var_j += s.weight * (s.j - mean_j) * (s.j - mean_j);
+    covariance += s.weight * (s.i - mean_i) * (s.j - mean_j);
+  }
+  // Flat windows (var 0) make kappa infinite: they are refused by both, with no error.
+  const double tiny = 1e-30;
+  *kappa = std::max((mean_i * mean_i + var_i) / std::max(var_i, tiny),
+                    (mean_j * mean_j + var_j) / std::max(var_j, tiny));
+  const double min_var = min_std * min_std;
+  if (std::abs(var_i / min_var - 1) < 0.05 || std::abs(var_j / min_var - 1) < 0.05) {
+    *near_threshold = true;
+  }
+  if (std::sqrt(var_i) < min_std || !(var_j > min_var)) return 2;
+  return 1 - std::clamp(covariance / std::sqrt(var_i * var_j), -1.0, 1.0);
+}
+
+// A homography near the identity about the window centre: shift up to 3 px, rotation up to
+// 10 degrees, scale 0.85..1.15, and a little perspective.
+Eigen::Matrix3d RandomNearIdentity(double centre, std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const double angle = 0.17 * unit(random), scale = 1 + 0.15 * unit(random);
+  Eigen::Matrix3d about = Eigen::Matrix3d::Identity(), back = Eigen::Matrix3d::Identity();
+  about.col(2) << -centre, -centre, 1;
+  back.col(2) << centre + 3 * unit(random), centre + 3 * unit(random), 1;
+  Eigen::Matrix3d warp = Eigen::Matrix3d::Identity();
+  warp.topLeftCorner<2, 2>() << scale * std::cos(angle), -scale * std::sin(angle),
+      scale * std::sin(angle), scale * std::cos(angle);
+  warp(2, 0) = 2e-3 * unit(random);
+  warp(2, 1) = 2e-3 * unit(random);
+  return back * warp * about;
+}
+
+TEST(FloatReference, WindowCostAgreesWithCentredDoubleMomentsWithinItsConditioning) {
+  // WindowCost computes variances and the covariance as E[I^2] - E[I]^2 in float: each
+  // cancels catastrophically when the mean is large against the contrast, losing a factor
+  // kappa = (mean^2 + var) / var. Windows of mean 0.05..0.95 and contrast down to the texture
+  // threshold (std 0.004, so kappa up to ~5e4) meet a randomly warped, relit source.
+  // Bound: |cost error| <= 16 kEps kappa: 16 samples, each adding a rounding of its products
+  // to the sums before the cancellation, which then divides by var.
+  std::mt19937 random(21);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const PatchMatchOptions options;
+  constexpr int kSize = 24;
+  double worst = 0, worst_scaled = 0;
+  int compared = 0, skipped = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const double mean = 0.05 + 0.9 * unit(random);
+    const double contrast = std::exp(std::log(0.006) + unit(random) * std::log(0.3 / 0.006));
+    const uint32_t seed = static_cast<uint32_t>(random());
+    std::mt19937 texture_random(seed);
+    const GrayImage reference = RandomWindowImage(kSize, mean, contrast, texture_random);
+    texture_random.seed(seed);
+    // The same texture relit: another mean and contrast, so the NCC stays high when the
+    // homography happens to be mild.
+    const GrayImage source = RandomWindowImage(kSize, 0.05 + 0.9 * unit(random),
+                                               contrast * (0.5 + unit(random)), texture_random);
+    const Eigen::Matrix3d h = RandomNearIdentity(kSize / 2.0, random);
+    double kappa = 1;
+    bool near_threshold = false;
+    const double expected =
+        ReferenceCost(reference, kSize / 2, kSize / 2, source, h, options, &kappa, &near_threshold);
+    const double actual = WindowCost(reference, kSize / 2, kSize / 2, source, h, options);
+    ASSERT_TRUE(std::isfinite(actual));
+    if (near_threshold) {
+      ++skipped;
+      continue;
+    }
+    ++compared;
+    const double error = std::abs(actual - expected);
+    worst = std::max(worst, error);
+    worst_scaled = std::max(worst_scaled, error / (kEps * kappa));
+    EXPECT_LE(error, 16 * kEps * kappa)
+        << "kappa " << kappa << " expected " << expected << " got " << actual;
+  }
+  Report("window_cost_worst_abs_error", worst, 0);
+  Report("window_cost_worst_error_over_eps_kappa", worst_scaled, 16);
+  EXPECT_GT(compared, 2700) << skipped << " near a threshold";
+}
+
+// ---- Forward warp: a source pixel with depth reprojected into the target (float) ----------
+
+Eigen::Quaterniond RandomRotation(std::mt19937& random, double max_angle_rad) {
+  std::normal_distribution<double> normal;
+  const Eigen::Vector3d axis =
+      Eigen::Vector3d(normal(random), normal(random), normal(random)).normalized();
+  return Eigen::Quaterniond(Eigen::AngleAxisd(
+      max_angle_rad * std::uniform_real_distribution<double>(0, 1)(random), axis));
+}
+
+// Sparse source samples (every 4th pixel, each alone) with log-uniform random depths in
+// [0.2, 200], coloured with their own pixel coordinates so the target tells which landed.
+SourceView SparseLabelledSource(std::mt19937& random) {
+  const Camera camera = MakePinholeCamera(1, 160, 120, 150, 140, 81.3, 58.7);
+  SourceView source{"sparse", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120)};
+  std::uniform_real_distribution<double> log_depth(std::log(0.2), std::log(200.0));
+  for (int y = 1; y < 120; y += 4) {
+    for (int x = 1; x < 160; x += 4) {
+      source.depth.At(x, y) = static_cast<float>(std::exp(log_depth(random)));
+      source.color.At(x, y, 0) = static_cast<float>(x) / 256;  // Exact in float.
+      source.color.At(x, y, 1) = static_cast<float>(y) / 256;
+    }
+  }
+  return source;
+}
+
+struct ProjectionErrors {
+  double depth_scaled = 0;  // Relative depth error over kappa.
+  double depth_relative = 0;
+  double angle_abs = 0;   // Absolute error of the chord WarpWeight::ray_angle_rad.
+  double pixel_miss = 0;  // How far the true projection lies outside the pixel written.
+  int samples = 0;
+};
+
+// Compares every sample that landed in `buffer` with the double projection of its source pixel.
+void CompareProjections(const SourceView& source, const PosedCamera& target,
+                        const WarpBuffer& buffer, ProjectionErrors* errors) {
+  const Rigid3d target_from_source = RelativePose(source.cam_from_world, target.cam_from_world);
+  const Eigen::Matrix3d rotation = target_from_source.rotation.toRotationMatrix();
+  const Camera& s = source.camera;
+  const Camera& t = target.camera;
+  for (int ty = 0; ty < buffer.Height(); ++ty) {
+    for (int tx = 0; tx < buffer.Width(); ++tx) {
+      const size_t i = static_cast<size_t>(ty) * buffer.Width() + tx;
+      const float z = buffer.Depth(i);
+      ASSERT_TRUE(z == 0 || (z > 0 && std::isfinite(z))) << z;
+      if (z == 0) continue;
+      const int x = static_cast<int>(std::lround(buffer.Color(i)[0] * 256));
+      const int y = static_cast<int>(std::lround(buffer.Color(i)[1] * 256));
+      const Eigen::Vector3d ray((x + 0.5 - s.PrincipalX()) / s.FocalX(),
+                                (y + 0.5 - s.PrincipalY()) / s.FocalY(), 1);
+      const Eigen::Vector3d point = rotation * (static_cast<double>(source.depth.At(x, y)) * ray) +
+                                    target_from_source.translation;
+      // Condition of z = depth (r_2 . ray) + t_2: the magnitudes summed against the result.
+      const double kappa = (static_cast<double>(source.depth.At(x, y)) *
+                                (rotation.row(2).cwiseAbs() * ray.cwiseAbs())(0) +
+                            std::abs(target_from_source.translation.z())) /
+                           point.z();
+      const double relative = std::abs(static_cast<double>(z) / point.z() - 1);
+      errors->depth_relative = std::max(errors->depth_relative, relative);
+      errors->depth_scaled = std::max(errors->depth_scaled, relative / (kEps * kappa));
+      const double chord = (point.normalized() - (rotation * ray).normalized()).norm();
+      errors->angle_abs = std::max(
+          errors->angle_abs, std::abs(static_cast<double>(buffer.Weight(i).ray_angle_rad) - chord));
+      const double u = t.FocalX() * point.x() / point.z() + t.PrincipalX();
+      const double v = t.FocalY() * point.y() / point.z() + t.PrincipalY();
+      errors->pixel_miss =
+          std::max({errors->pixel_miss, tx - u, u - (tx + 1), ty - v, v - (ty + 1)});
+      ++errors->samples;
+    }
+  }
+}
+
+TEST(FloatReference, ForwardWarpReprojectionAgreesWithDoubleWithinItsConditioning) {
+  // Each isolated source sample is splatted onto exactly one target pixel (max_splat_px 1):
+  // its depth is the float z of ProjectSpan, its ray angle the float chord between unit rays.
+  // z = depth (r_2 . ray) + t_2 sums terms that can cancel (a target far off to the side),
+  // so its error is a few roundings times kappa = (|depth r_2 . ray| + |t_2|) / z. Bound:
+  // 8 kEps kappa (the pose and ray rounded to float, ~5 operations, 1 / z twice). The chord
+  // is a difference of unit vectors, so its error is absolute: bound 8 kEps.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  ProjectionErrors errors;
+  ForwardWarpOptions options;
+  options.method = WarpMethod::kSplat;
+  options.max_splat_px = 1;
+  options.background_at_infinity = false;
+  WarpBuffer buffer;
+  for (int trial = 0; trial < 12; ++trial) {
+    const SourceView source = SparseLabelledSource(random);
+    const Camera target_camera = MakePinholeCamera(1, 200, 150, 170, 175, 99.1, 76.4);
+    const Eigen::Quaterniond rotation = RandomRotation(random, 0.5);
+    const Eigen::Vector3d centre(2 * unit(random), 2 * unit(random), 2 * unit(random));
+    const PosedCamera target{target_camera, Rigid3d(rotation, -(rotation * centre))};
+    ForwardWarp(source, target, options, &buffer);
+    CompareProjections(source, target, buffer, &errors);
+  }
+  Report("warp_depth_worst_relative_error", errors.depth_relative, 0);
+  Report("warp_depth_worst_error_over_eps_kappa", errors.depth_scaled, 8);
+  Report("warp_ray_angle_worst_abs_error", errors.angle_abs, 8 * kEps);
+  Report("warp_pixel_worst_miss_px", errors.pixel_miss, 1e-3);
+  EXPECT_GT(errors.samples, 2000);
+  EXPECT_LT(errors.depth_scaled, 8);
+  EXPECT_LT(errors.angle_abs, 8 * kEps);
+  // Which pixel a sample lands in: float u is off by ~kEps |u| ~ 2e-5 px.
+  EXPECT_LT(errors.pixel_miss, 1e-3);
+}
+
+// A random plane n . x = d in front of a camera at the origin looking along +z.
+struct RandomPlane {
+  Eigen::Vector3d normal;
+  double offset;
+};
+
+RandomPlane MakeRandomPlane(std::mt19937& random) {
+  std::uniform_real_distribution<double> unit(-1, 1);
+  // Normals within ~50 degrees of the view axis, the plane crossing it at depth 2..20.
+  const Eigen::Vector3d normal =
+      Eigen::Vector3d(0.8 * unit(random), 0.8 * unit(random), -1).normalized();
+  const double depth = std::exp(std::log(2.0) + (unit(random) + 1) / 2 * std::log(10.0));
+  return {normal, normal.dot(Eigen::Vector3d(0, 0, depth))};
+}
+
+// Depth (camera z) where the ray of pixel (x, y) of `camera` meets the plane, in double; 0
+// where it does not (or behind).
+double PlaneDepth(const RandomPlane& plane, const PosedCamera& camera, double x, double y) {
+  const Eigen::Vector3d ray_in_cam((x + 0.5 - camera.camera.PrincipalX()) / camera.camera.FocalX(),
+                                   (y + 0.5 - camera.camera.PrincipalY()) / camera.camera.FocalY(),
+                                   1);
+  const Eigen::Vector3d ray = camera.cam_from_world.rotation.conjugate() * ray_in_cam;
+  const Eigen::Vector3d centre = CameraCenter(camera.cam_from_world);
+  const double denominator = plane.normal.dot(ray);
+  if (std::abs(denominator) < 1e-12) return 0;
+  const double t = (plane.offset - plane.normal.dot(centre)) / denominator;
+  return t > 0 ? t : 0;
+}
+
+TEST(FloatReference, MeshWarpOfAPlaneAgreesWithDoubleRayCasting) {
+  // The mesh interpolates 1 / z perspective-correctly, exact on a plane, so what remains is
+  // float rounding: the source depth stored as float (kEps / 2), the vertex projection (see
+  // above, kappa ~ 1 here) and the barycentric interpolation. Target pixels near the source's
+  // border are left out (the border is splatted, flat). Bound on the relative depth error:
+  // 64 kEps (measured ~8e-7: the interpolation weights come from target coordinates of ~100
+  // px rounded to ~1e-5 px, over triangles a pixel wide).
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  const Camera camera = MakePinholeCamera(1, 96, 72, 90, 90, 48, 36);
+  const PosedCamera source_camera{camera, Rigid3d()};
+  double worst = 0;
+  long compared = 0;
+  WarpBuffer buffer;
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomPlane plane = MakeRandomPlane(random);
+    SourceView source{"plane", camera, Rigid3d(), Image(96, 72, 3), DepthMap(96, 72)};
+    for (int y = 0; y < 72; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        source.depth.At(x, y) = static_cast<float>(PlaneDepth(plane, source_camera, x, y));
+      }
+    }
+    const Eigen::Quaterniond rotation = RandomRotation(random, 0.3);
+    const Eigen::Vector3d centre =
+        0.1 * plane.offset * Eigen::Vector3d(unit(random), unit(random), unit(random));
+    const PosedCamera target{camera, Rigid3d(rotation, -(rotation * centre))};
+    ForwardWarp(source, target, {}, &buffer);
+    for (int y = 0; y < 72; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        const float z = buffer.Depth(static_cast<size_t>(y) * 96 + x);
+        ASSERT_TRUE(z == 0 || (z > 0 && std::isfinite(z))) << z;
+        if (z == 0) continue;
+        const double truth = PlaneDepth(plane, target, x, y);
+        ASSERT_GT(truth, 0);
+        // Where the point lies in the source: leave out the splatted border.
+        const Eigen::Vector3d ray = target.cam_from_world.rotation.conjugate() *
+                                    Eigen::Vector3d((x + 0.5 - 48) / 90, (y + 0.5 - 36) / 90, 1);
+        const std::optional<Eigen::Vector2d> in_source =
+            camera.Project(CameraCenter(target.cam_from_world) + truth * ray);
+        if (!in_source || in_source->x() < 1.5 || in_source->y() < 1.5 || in_source->x() > 94.5 ||
+            in_source->y() > 70.5)
+          continue;
+        worst = std::max(worst, std::abs(static_cast<double>(z) / truth - 1));
+        ++compared;
+      }
+    }
+  }
+  Report("mesh_warp_plane_worst_relative_depth_error", worst, 64 * kEps);
+  EXPECT_GT(compared, 20000);
+  EXPECT_LT(worst, 64 * kEps);
+}
+
+// ---- Viewer: reverse-Z projection (float matrices, float depth buffer) --------------------
+
+TEST(FloatReference, ReverseZKeepsFloatDepthPrecisionOverAMillionToOneRange) {
+  // ndc_z = near / z, computed as the GPU does: float matrix times float point, then divided
+  // by w. No cancellation: near is rounded once, the division once, so the depth read back
+  // from the buffer is within 2 roundings (kEps) of the truth at every depth from near to
+  // 1e6 near. Pixel positions: |ndc_x error| <= a few kEps, i.e. < 1e-3 px at 640 px.
+  // The conventional projection, ndc_z = a + b / z, cancels near far (a ~ 1, b / z ~ -1):
+  // its depth error grows to ~kEps far / near, which reverse-Z exists to avoid; checked as a
+  // contrast so a swapped projection fails.
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> unit(0, 1);
+  const Camera camera = MakePinholeCamera(1, 640, 480, 520, 510, 323.5, 236.25);
+  double worst_reverse = 0, worst_conventional_far = 0, worst_pixel = 0;
+  for (const double near : {1e-3, 0.05, 2.0}) {
+    const double far = 1e6 * near;
+    const Eigen::Matrix4f reverse = ReverseZProjection(camera, near);
+    const Eigen::Matrix4f conventional =
+        PerspectiveProjection(camera, near, far, DepthRange::kZeroToOne);
+    const double b = -near * far / (far - near), a = -b / near;  // Conventional, in double.
+    for (int i = 0; i < 2000; ++i) {
+      const double z = near * std::pow(1e6, unit(random));
+      const Eigen::Vector4f point(static_cast<float>((640 * unit(random) - 323.5) / 520 * z),
+                                  static_cast<float>((480 * unit(random) - 236.25) / 510 * z),
+                                  static_cast<float>(z), 1.0f);
+      const double zf = point.z();  // The depth the float point really has.
+      const Eigen::Vector4f clip = reverse * point;
+      const float ndc_z = clip.z() / clip.w();  // What the depth buffer stores.
+      worst_reverse =
+          std::max(worst_reverse, std::abs((near / static_cast<double>(ndc_z)) / zf - 1));
+      const double u = 520 * static_cast<double>(point.x()) / zf + 323.5;
+      const double ndc_x = 2 * u / 640 - 1;
+      worst_pixel =
+          std::max(worst_pixel, std::abs(static_cast<double>(clip.x() / clip.w()) - ndc_x) * 320);
+      if (zf > 0.5 * far) {
+        const Eigen::Vector4f conventional_clip = conventional * point;
+        const double ndc = conventional_clip.z() / conventional_clip.w();
+        worst_conventional_far = std::max(worst_conventional_far, std::abs(b / (ndc - a) / zf - 1));
+      }
+    }
+  }
+  Report("reverse_z_worst_relative_depth_error", worst_reverse, 2 * kEps);
+  Report("reverse_z_worst_pixel_error_px", worst_pixel, 1e-3);
+  Report("conventional_z_worst_relative_depth_error_at_far", worst_conventional_far, 0);
+  EXPECT_LT(worst_reverse, 2 * kEps);
+  EXPECT_LT(worst_pixel, 1e-3);
+  EXPECT_GT(worst_conventional_far, 1000 * worst_reverse);
+}
+
+TEST(FloatReference, ReverseZSeparatesDepthsOnePartInAMillionApartAtEveryRange) {
+  // No z-fighting anywhere in near..1e6 near: two surfaces 1e-6 apart (relative) get
+  // different, correctly ordered float depths. 1e-6 is 8 to 16 ulps of ndc_z; after rounding
+  // z itself they must stay at least 4 ulps apart.
+  const Camera camera = MakePinholeCamera(1, 640, 480, 520, 520, 320, 240);
+  const double near = 0.01;
+  const Eigen::Matrix4f reverse = ReverseZProjection(camera, near);
+  for (double z = near; z <= 1e6 * near; z *= 1.37) {
+    const float z_near = static_cast<float>(z), z_far = static_cast<float>(z * (1 + 1e-6));
+    const float front = (reverse * Eigen::Vector4f(0, 0, z_near, 1)).z() / z_near;
+    const float back = (reverse * Eigen::Vector4f(0, 0, z_far, 1)).z() / z_far;
+    ASSERT_GT(front, back) << "at depth " << z;
+    EXPECT_GE(front - back, 4 * std::nextafter(back, 2.0f) - 4 * back) << "at depth " << z;
+  }
+}
+
+// ---- Viewer: planar shadow matrix (float) ---------------------------------------------------
+
+TEST(FloatReference, PlanarShadowsAgreeWithDoubleUpToGrazingLight) {
+  // S = M X / w with M = (pi . l) I - l pi^T, for a directional light up to 89.9 degrees from
+  // the ground's normal (shadows 573 times longer than the caster is high). Row i of the
+  // float product sums terms bounded by |pi . l| |X_i| + |l_i| sum_j |pi_j X_j|, each entry
+  // and product rounded, then divides by w = pi . l (exact up to one rounding). Relative to
+  // the shadow's length |S - X|, the error is a few roundings times
+  // kappa = (|X|_1 + sum_j |pi_j X_j| / |pi . l|) / |S - X| + 1. Bound: 8 kEps kappa.
+  std::mt19937 random(4);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  GroundPlane ground;
+  ground.normal = Eigen::Vector3d(0.1, -0.05, 1).normalized();
+  ground.offset = 0.3;
+  double worst_scaled = 0, worst_relative = 0;
+  for (const double angle_deg : {0.0, 30.0, 60.0, 85.0, 89.0, 89.9}) {
+    const double angle = angle_deg * std::numbers::pi / 180;
+    // Towards the light: tilted `angle` from the normal.
+    const Eigen::Vector3d side = ground.normal.cross(Eigen::Vector3d::UnitX()).normalized();
+    const Eigen::Vector3d towards = std::cos(angle) * ground.normal + std::sin(angle) * side;
+    const Eigen::Vector4d light(towards.x(), towards.y(), towards.z(), 0);
+    const Eigen::Matrix4f m = PlanarShadowMatrix(ground, light);
+    const Eigen::Vector4d pi(ground.normal.x(), ground.normal.y(), ground.normal.z(),
+                             ground.offset);
+    for (int i = 0; i < 500; ++i) {
+      // Casters up to 10 above the ground, over a 20 x 20 area.
+      Eigen::Vector3d x(10 * unit(random), 10 * unit(random), 0);
+      x += (-ground.offset - ground.normal.dot(x)) * ground.normal;        // On the ground ...
+      x += 5 * (1 + unit(random)) * ground.normal + 1e-3 * ground.normal;  // ... then lifted.
+      const Eigen::Vector4f xf(static_cast<float>(x.x()), static_cast<float>(x.y()),
+                               static_cast<float>(x.z()), 1.0f);
+      const Eigen::Vector4d xd = xf.cast<double>();
+      const Eigen::Vector4f shadow_f = m * xf;
+      const Eigen::Vector3d shadow =
+          shadow_f.head<3>().cast<double>() / static_cast<double>(shadow_f.w());
+      const Eigen::Vector3d truth = xd.head<3>() - (pi.dot(xd) / pi.dot(light)) * light.head<3>();
+      const double length = (truth - xd.head<3>()).norm();
+      const double kappa =
+          (xd.head<3>().lpNorm<1>() + pi.cwiseProduct(xd).lpNorm<1>() / std::abs(pi.dot(light))) /
+              length +
+          1;
+      const double relative = (shadow - truth).norm() / length;
+      worst_relative = std::max(worst_relative, relative);
+      worst_scaled = std::max(worst_scaled, relative / (kEps * kappa));
+    }
+  }
+  Report("planar_shadow_worst_relative_error", worst_relative, 0);
+  Report("planar_shadow_worst_error_over_eps_kappa", worst_scaled, 8);
+  EXPECT_LT(worst_scaled, 8);
+}
+
+}  // namespace
+}  // namespace parallax
