@@ -313,7 +313,7 @@ void RegisterBenchCommand(CLI::App& app) {
         {"sfm", "rotation_error_deg", "rotation error (deg)", false, "s"},
         {"depth", "within_2pct", "within 2% (share)", true, "s per view"},
         {"render", "psnr", "PSNR (dB)", true, "ms per view"},
-        {"shadows", "iou_cast", "cast-shadow IoU vs Embree", true, "ms per frame, light moving"}};
+        {"shadows", "iou_cast", "cast-shadow IoU vs Embree", true, "ms per frame (light moving)"}};
     const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     WriteBenchReport(bench.Out(), bench.rows, stages, DescribeMachine(), bench.leave_out, total);
     std::printf("bench: %zu runs in %.0f s -> %s (report.md, bench.csv, error_vs_time.png)\n",

@@ -40,6 +40,14 @@ std::string TimeUnit(const std::string& stage, const std::vector<BenchStage>& st
   return "s";
 }
 
+// A CSV field (RFC 4180): quoted, with quotes doubled, when it holds a comma or a quote.
+std::string CsvField(const std::string& text) {
+  if (text.find_first_of(",\"\n") == std::string::npos) return text;
+  std::string quoted = "\"";
+  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
 std::string Csv(const std::vector<BenchRow>& rows, const std::vector<BenchStage>& stages,
                 const Machine& machine) {
   const std::vector<std::string> columns = MetricColumns(rows);
@@ -54,10 +62,10 @@ std::string Csv(const std::vector<BenchRow>& rows, const std::vector<BenchStage>
     }
     for (const std::string& field :
          {Number(row.time), TimeUnit(row.stage, stages), Number(row.wall_s), Number(row.peak_mb),
-          "\"" + machine.cpu + "\"", std::to_string(machine.cores)}) {
+          machine.cpu, std::to_string(machine.cores)}) {
       fields.push_back(field);
     }
-    for (size_t i = 0; i < fields.size(); ++i) csv.append(i ? "," : "").append(fields[i]);
+    for (size_t i = 0; i < fields.size(); ++i) csv.append(i ? "," : "").append(CsvField(fields[i]));
     csv.append("\n");
   }
   return csv;
