@@ -7,12 +7,12 @@
 #include <map>
 #include <set>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
-
-#include <opencv2/imgproc.hpp>
 
 namespace parallax {
 namespace fs = std::filesystem;

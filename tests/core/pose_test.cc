@@ -6,14 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/random_rotation.h"
+
 namespace parallax {
 namespace {
 
-Eigen::Quaterniond RandomRotation(std::mt19937& random) {
-  std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random))
-      .normalized();
-}
+using test::RandomRotation;
 
 TEST(Pose, CameraCenterMapsToTheOrigin) {
   std::mt19937 random(1);

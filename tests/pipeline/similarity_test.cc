@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/random_rotation.h"
+
 namespace parallax {
 namespace {
 
@@ -30,11 +32,7 @@ constexpr double kLargeOffsetDeg = 1e-6;
 constexpr double kCollinearRelative = 1e-8;
 constexpr double kCollinearDeg = 1e-6;
 
-Eigen::Quaterniond RandomRotation(std::mt19937& random) {
-  std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random))
-      .normalized();
-}
+using test::RandomRotation;
 
 Eigen::Vector3d RandomVector(std::mt19937& random, double sigma) {
   std::normal_distribution<double> normal(0, sigma);

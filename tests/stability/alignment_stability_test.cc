@@ -13,16 +13,14 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/random_rotation.h"
+
 #include "pipeline/similarity.h"
 
 namespace parallax {
 namespace {
 
-Eigen::Quaterniond RandomRotation(std::mt19937& random) {
-  std::normal_distribution<double> normal;
-  return Eigen::Quaterniond(normal(random), normal(random), normal(random), normal(random))
-      .normalized();
-}
+using test::RandomRotation;
 
 Rigid3d CameraAt(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& centre) {
   return Rigid3d(rotation, -(rotation * centre));
