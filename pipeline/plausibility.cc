@@ -1,20 +1,36 @@
 #include "pipeline/plausibility.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <numbers>
+#include <numeric>
+#include <optional>
 #include <stdexcept>
+#include <thread>
 #include <unordered_map>
+#include <unordered_set>
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
 
 namespace parallax {
 namespace {
 
 constexpr size_t kMaxTrackForAngles = 16;
+// The focal test uses at most this many observations of each point, and this many solver
+// iterations: a solve cut short only overstates the error of a wrong focal length (the start
+// is already a solution when the focal length is free), so it never hides a problem.
+constexpr size_t kMaxTrackForFocalTest = 16;
+constexpr int kFocalTestIterations = 25;
+// Residual for a point the focal test cannot project (behind a camera): large and constant,
+// so the solver moves away from it instead of failing (a failed evaluation ends the solve).
+constexpr double kUnprojectableResidualPx = 1e3;
 
 __attribute__((format(printf, 1, 2))) std::string Format(const char* format, ...) {
-  char text[256];
+  char text[512];
   va_list arguments;
   va_start(arguments, format);
   std::vsnprintf(text, sizeof(text), format, arguments);
@@ -29,7 +45,173 @@ double Median(std::vector<double> values) {
   return *middle;
 }
 
+// Focal length parameters, then principal point: the parameters the focal test holds.
+int NumHeldParams(CameraModel model) {
+  return model == CameraModel::kPinhole || model == CameraModel::kOpenCV ? 4 : 3;
+}
+
+// `camera` with its focal length scaled by `factor` and its distortion rewritten for
+// normalised coordinates divided by `factor` (radial terms of degree 2n scale by factor^2n,
+// tangential ones by factor), so the image of the scaled scene is unchanged.
+std::vector<double> ScaledIntrinsics(const Camera& camera, double factor) {
+  std::vector<double> params = camera.params;
+  const double f2 = factor * factor;
+  switch (camera.model) {
+    case CameraModel::kSimplePinhole: params[0] *= factor; break;
+    case CameraModel::kPinhole: params[0] *= factor; params[1] *= factor; break;
+    case CameraModel::kSimpleRadial: params[0] *= factor; params[3] *= f2; break;
+    case CameraModel::kRadial: params[0] *= factor; params[3] *= f2; params[4] *= f2 * f2; break;
+    case CameraModel::kOpenCV:
+      params[0] *= factor; params[1] *= factor;
+      params[4] *= f2; params[5] *= f2 * f2; params[6] *= factor; params[7] *= factor;
+      break;
+    default: break;  // Excluded by the caller (no projection).
+  }
+  return params;
+}
+
+// One observation: parameter blocks cam_from_world rotation (w, x, y, z), translation,
+// point, camera parameters.
+struct ReprojectionResidual {
+  Camera camera;
+  Eigen::Vector2d observed;
+
+  bool operator()(double const* const* blocks, double* residual) const {
+    Camera scratch = camera;
+    std::copy(blocks[3], blocks[3] + scratch.params.size(), scratch.params.begin());
+    double rotated[3];
+    ceres::QuaternionRotatePoint(blocks[0], blocks[2], rotated);
+    const Eigen::Vector3d point_in_cam(rotated[0] + blocks[1][0], rotated[1] + blocks[1][1],
+                                       rotated[2] + blocks[1][2]);
+    const std::optional<Eigen::Vector2d> pixel = scratch.Project(point_in_cam);
+    residual[0] = pixel ? (*pixel)[0] - observed[0] : kUnprojectableResidualPx;
+    residual[1] = pixel ? (*pixel)[1] - observed[1] : kUnprojectableResidualPx;
+    return true;
+  }
+};
+
+std::vector<size_t> FocalTestPoints(const SparseModel& model, int max_points) {
+  std::vector<size_t> usable;
+  for (size_t i = 0; i < model.Points3D().size(); ++i) {
+    if (model.Points3D()[i].track.size() >= 2) usable.push_back(i);
+  }
+  const size_t stride = std::max<size_t>(1, (usable.size() + static_cast<size_t>(max_points) - 1) /
+                                                static_cast<size_t>(max_points));
+  std::vector<size_t> chosen;
+  for (size_t i = 0; i < usable.size(); i += stride) chosen.push_back(usable[i]);
+  return chosen;
+}
+
+double RmsReprojectionError(const SparseModel& model, const std::vector<size_t>& points) {
+  double sum = 0;
+  size_t count = 0;
+  for (const size_t index : points) {
+    const Point3D& point = model.Points3D()[index];
+    for (size_t k = 0; k < std::min(point.track.size(), kMaxTrackForFocalTest); ++k) {
+      const TrackElement& element = point.track[k];
+      const SparseImage& image = model.ImageById(element.image_id);
+      const std::optional<Eigen::Vector2d> pixel =
+          model.CameraById(image.camera_id).Project(image.cam_from_world * point.xyz);
+      const Eigen::Vector2d& observed = image.points2d.at(element.point2d_idx).xy;
+      sum += pixel ? (*pixel - observed).squaredNorm()
+                   : 2 * kUnprojectableResidualPx * kUnprojectableResidualPx;
+      ++count;
+    }
+  }
+  return count == 0 ? 0 : std::sqrt(sum / static_cast<double>(count));
+}
+
 }  // namespace
+
+double FocalRmsRatio(const SparseModel& model, double factor, int max_points) {
+  if (!(factor > 0) || max_points < 1) {
+    throw std::invalid_argument("FocalRmsRatio: factor must be > 0 and max_points >= 1");
+  }
+  for (const Camera& camera : model.Cameras()) {
+    if (!IsProjectionSupported(camera.model)) return 0;
+  }
+  const std::vector<size_t> points = FocalTestPoints(model, max_points);
+  if (points.empty() || model.Images().empty()) return 0;
+  const double rms_before = RmsReprojectionError(model, points);
+
+  // Start from the exact ambiguity of pure translation: in the frame of the first camera,
+  // divide lateral coordinates by `factor` and keep depth; with every camera oriented like the
+  // first, the images are unchanged and the solver has nothing to do.
+  const Eigen::Matrix3d reference =
+      model.Images().front().cam_from_world.rotation.toRotationMatrix();
+  const Eigen::Matrix3d squeeze =
+      reference.transpose() * Eigen::Vector3d(1 / factor, 1 / factor, 1).asDiagonal() * reference;
+  std::unordered_map<uint32_t, std::vector<double>> intrinsics;
+  for (const Camera& camera : model.Cameras()) {
+    intrinsics[camera.id] = ScaledIntrinsics(camera, factor);
+  }
+  std::unordered_map<uint32_t, std::array<double, 7>> poses;  // w, x, y, z, t.
+  for (const SparseImage& image : model.Images()) {
+    const Eigen::Quaterniond& rotation = image.cam_from_world.rotation;
+    const Eigen::Vector3d translation = -(rotation * (squeeze * CameraCenter(image.cam_from_world)));
+    poses[image.id] = {rotation.w(), rotation.x(), rotation.y(), rotation.z(),
+                       translation.x(), translation.y(), translation.z()};
+  }
+  std::vector<Eigen::Vector3d> xyz;
+  xyz.reserve(points.size());
+  for (const size_t index : points) xyz.push_back(squeeze * model.Points3D()[index].xyz);
+
+  ceres::Problem problem;
+  std::unordered_set<uint32_t> images_used;
+  uint32_t gauge_image = 0;
+  size_t residuals = 0;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const std::vector<TrackElement>& track = model.Points3D()[points[p]].track;
+    for (size_t k = 0; k < std::min(track.size(), kMaxTrackForFocalTest); ++k) {
+      const TrackElement& element = track[k];
+      const SparseImage& image = model.ImageById(element.image_id);
+      const Camera& camera = model.CameraById(image.camera_id);
+      auto* cost = new ceres::DynamicNumericDiffCostFunction<ReprojectionResidual, ceres::CENTRAL>(
+          new ReprojectionResidual{camera, image.points2d.at(element.point2d_idx).xy});
+      cost->AddParameterBlock(4);
+      cost->AddParameterBlock(3);
+      cost->AddParameterBlock(3);
+      cost->AddParameterBlock(static_cast<int>(camera.params.size()));
+      cost->SetNumResiduals(2);
+      std::array<double, 7>& pose = poses.at(image.id);
+      problem.AddResidualBlock(cost, nullptr,
+                               {pose.data(), pose.data() + 4, xyz[p].data(),
+                                intrinsics.at(camera.id).data()});
+      if (images_used.empty()) gauge_image = image.id;
+      images_used.insert(image.id);
+      ++residuals;
+    }
+  }
+  for (const uint32_t id : images_used) {
+    problem.SetManifold(poses.at(id).data(), new ceres::QuaternionManifold);
+  }
+  for (const Camera& camera : model.Cameras()) {
+    double* block = intrinsics.at(camera.id).data();
+    if (!problem.HasParameterBlock(block)) continue;
+    const int held = NumHeldParams(camera.model);
+    const int size = static_cast<int>(camera.params.size());
+    if (held == size) {
+      problem.SetParameterBlockConstant(block);
+    } else {
+      std::vector<int> constant(static_cast<size_t>(held));
+      std::iota(constant.begin(), constant.end(), 0);
+      problem.SetManifold(block, new ceres::SubsetManifold(size, constant));
+    }
+  }
+  // Gauge: one camera held; the scale stays free (the damping copes with that direction).
+  problem.SetParameterBlockConstant(poses.at(gauge_image).data());
+  problem.SetParameterBlockConstant(poses.at(gauge_image).data() + 4);
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = kFocalTestIterations;
+  options.num_threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  const double rms_after = std::sqrt(2 * summary.final_cost / static_cast<double>(residuals));
+  return rms_after / std::max(rms_before, 1e-9);
+}
 
 void PlausibilityOptions::Check() const {
   if (!(max_focal_ratio_exif > 1)) throw std::invalid_argument("max_focal_ratio_exif must be > 1");
@@ -44,6 +226,9 @@ void PlausibilityOptions::Check() const {
     throw std::invalid_argument("max_principal_point_offset must be > 0");
   }
   if (min_points_per_image < 1) throw std::invalid_argument("min_points_per_image must be >= 1");
+  if (!(focal_test_factor > 1)) throw std::invalid_argument("focal_test_factor must be > 1");
+  if (!(min_focal_rms_ratio > 1)) throw std::invalid_argument("min_focal_rms_ratio must be > 1");
+  if (focal_test_max_points < 1) throw std::invalid_argument("focal_test_max_points must be >= 1");
 }
 
 double PrincipalPointOffset(const Camera& camera) {
@@ -95,6 +280,22 @@ PlausibilityReport CheckPlausibility(const SparseModel& model, double focal_prio
     report.problems.push_back(Format(
         "estimated focal length %.1f px is %.2fx its prior %.1f px", report.focal_px, ratio,
         focal_prior_px) + (prior_from_exif ? " (from EXIF)" : " (from the image size)"));
+  }
+
+  if (!prior_from_exif) {
+    // Without EXIF the prior is a guess, and a focal length the photos do not determine stays
+    // wherever COLMAP's drift left it: 1.5-7x wrong at 0.1 px error on telephoto slider
+    // captures (tests/stability/sfm_stability_test.cc), inside the range allowed above.
+    report.focal_rms_ratio =
+        std::min(FocalRmsRatio(model, options.focal_test_factor, options.focal_test_max_points),
+                 FocalRmsRatio(model, 1 / options.focal_test_factor, options.focal_test_max_points));
+    if (report.focal_rms_ratio > 0 && report.focal_rms_ratio < options.min_focal_rms_ratio) {
+      report.problems.push_back(Format(
+          "estimated focal length %.1f px is not determined by the photos: held at %gx or "
+          "1/%gx that, the model fits them with %.2fx the reprojection error (the cameras "
+          "barely rotate relative to each other: a slider or a tiny baseline)", report.focal_px,
+          options.focal_test_factor, options.focal_test_factor, report.focal_rms_ratio));
+    }
   }
 
   for (const Camera& camera : model.Cameras()) {

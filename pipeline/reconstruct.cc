@@ -368,6 +368,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
             {"focal_prior_px", plausibility.focal_prior_px},
             {"prior_from_exif", plausibility.prior_from_exif},
             {"median_triangulation_deg", plausibility.median_triangulation_deg},
+            {"focal_rms_ratio", plausibility.focal_rms_ratio},
             {"well_constrained_image_share", plausibility.well_constrained_image_share},
             {"problems", plausibility.problems}}},
           {"depth", summary.depth_views},
