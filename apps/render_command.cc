@@ -106,6 +106,7 @@ void RegisterRenderCommand(CLI::App& app) {
         arguments->cameras.empty()
             ? CamerasAlongPath(arguments->path, library.Cameras(), library.Names())
             : CamerasFromModel(arguments->cameras);
+    const size_t all_views = library.Cameras().size();
     nlohmann::json stages = nlohmann::json::array();
     if (std::filesystem::is_directory(arguments->input / "gt")) {
       stages.push_back(Stage("depth", "a scene folder: its ground-truth depth maps are used"));
@@ -114,14 +115,13 @@ void RegisterRenderCommand(CLI::App& app) {
       stages.push_back(estimated.empty()
                            ? Stage("depth", "every source view these cameras use already has a depth map")
                            : Stage("depth", "", "estimated for " + std::to_string(estimated.size()) + " of " +
-                                                    std::to_string(library.Cameras().size()) +
+                                                    std::to_string(all_views) +
                                                     " views: those these cameras use and had none"));
     }
     // What `reconstruct` would also make, and a request for novel views alone does not need.
     stages.push_back(Stage("fusion", "novel views warp each source's depth map; no fused cloud is needed"));
     stages.push_back(Stage("mesh", "only novel views are requested: the Poisson mesh and its texture atlas "
                                    "are for the viewer, and the warp does not use them"));
-    const size_t all_views = library.Cameras().size();
     for (const std::string& name : library.DropViewsWithoutDepth()) {
       std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
                    name.c_str());
@@ -155,7 +155,8 @@ void RegisterRenderCommand(CLI::App& app) {
       fill_skips += "; skipped for " + std::to_string(count) + ": " + reason;
       skipped_views += count;
     }
-    stages.push_back(Stage("fill", skipped_views == targets.size() ? fill_skips.substr(2) : "",
+    const bool none_filled = !fill_skipped.empty() && skipped_views == targets.size();
+    stages.push_back(Stage("fill", none_filled ? fill_skips.substr(2) : "",
                            "ran for " + std::to_string(targets.size() - skipped_views) + " of " +
                                std::to_string(targets.size()) + " views" + fill_skips));
     WriteFileAtomically(arguments->out / "report.json", nlohmann::json({{"render", {{"stages", stages}}}}).dump(2) + "\n");

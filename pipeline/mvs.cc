@@ -48,29 +48,36 @@ void ScaleView(StereoView& view, double scale) {
                                   view.camera.PrincipalX() * sx, view.camera.PrincipalY() * sy);
 }
 
-// Back to the photo's size: each pixel takes the estimate of the low-resolution pixel its
-// centre falls in.
-DepthNormalMap UpsampleNearest(const DepthNormalMap& estimate, int width, int height) {
-  const int low_width = estimate.depth.Width(), low_height = estimate.depth.Height();
-  if (low_width == width && low_height == height) return estimate;
-  DepthNormalMap full{DepthMap(width, height), std::vector<float>(static_cast<size_t>(width) * height * 3),
-                      std::vector<float>(static_cast<size_t>(width) * height)};
+// Back to the photo's size, nearest: for each pixel of a width x height image (row-major), the
+// index of the low_width x low_height pixel its centre falls in.
+std::vector<size_t> NearestLowResolutionPixels(int low_width, int low_height, int width, int height) {
+  std::vector<size_t> nearest;
+  nearest.reserve(static_cast<size_t>(width) * static_cast<size_t>(height));
   for (int y = 0; y < height; ++y) {
     const int ly = std::min(low_height - 1, static_cast<int>((y + 0.5) * low_height / height));
     for (int x = 0; x < width; ++x) {
       const int lx = std::min(low_width - 1, static_cast<int>((x + 0.5) * low_width / width));
-      const size_t low = static_cast<size_t>(ly) * low_width + lx, high = static_cast<size_t>(y) * width + x;
-      full.depth.At(x, y) = estimate.depth.At(lx, ly);
-      if (!estimate.cost.empty()) full.cost[high] = estimate.cost[low];
-      for (int c = 0; c < 3; ++c) full.normal[3 * high + c] = estimate.normal[3 * low + c];
+      nearest.push_back(static_cast<size_t>(ly) * static_cast<size_t>(low_width) + static_cast<size_t>(lx));
     }
   }
+  return nearest;
+}
+
+DepthMap UpsampleNearest(const DepthMap& depth, const std::vector<size_t>& nearest, int width, int height) {
+  DepthMap full(width, height);
+  for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
   return full;
 }
 
-DepthMap UpsampleNearest(const DepthMap& depth, int width, int height) {
-  return UpsampleNearest(DepthNormalMap{depth, std::vector<float>(depth.Values().size() * 3), {}}, width, height)
-      .depth;
+DepthNormalMap UpsampleNearest(const DepthNormalMap& estimate, const std::vector<size_t>& nearest, int width,
+                               int height) {
+  DepthNormalMap full{UpsampleNearest(estimate.depth, nearest, width, height),
+                      std::vector<float>(3 * nearest.size()), std::vector<float>(estimate.cost.empty() ? 0 : nearest.size())};
+  for (size_t i = 0; i < nearest.size(); ++i) {
+    if (!estimate.cost.empty()) full.cost[i] = estimate.cost[nearest[i]];
+    for (size_t c = 0; c < 3; ++c) full.normal[3 * i + c] = estimate.normal[3 * nearest[i] + c];
+  }
+  return full;
 }
 
 double Seconds(std::chrono::steady_clock::time_point start) {
@@ -224,9 +231,14 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
     // Every file at the photo's size, whatever the resolution of the estimate.
     const Camera& camera = model.CameraById(model.ImageById(plan.image_id).camera_id);
     const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
-    const DepthNormalMap estimate = UpsampleNearest(low, width, height);
-    filtered.depth = UpsampleNearest(filtered.depth, width, height);
-    filtered.confidence = UpsampleNearest(filtered.confidence, width, height);
+    const bool same_size = low.depth.Width() == width && low.depth.Height() == height;
+    const std::vector<size_t> nearest =
+        same_size ? std::vector<size_t>() : NearestLowResolutionPixels(low.depth.Width(), low.depth.Height(), width, height);
+    const DepthNormalMap estimate = same_size ? low : UpsampleNearest(low, nearest, width, height);
+    if (!same_size) {
+      filtered.depth = UpsampleNearest(filtered.depth, nearest, width, height);
+      filtered.confidence = UpsampleNearest(filtered.confidence, nearest, width, height);
+    }
 
     const std::string stem = fs::path(plan.name).stem().string();
     WriteColmapDepth(stereo / "depth_maps" / (plan.name + ".photometric.bin"),

@@ -26,7 +26,6 @@ void SetVertexLayout() {
 // The mesh's positions, shared between triangles and drawn by index, for depth-only passes
 // (the eye's pre-pass, shadow maps, projector depth): a third of the vertex work of the
 // per-corner buffer below, a quarter of its bytes. Position 0 is the only attribute.
-
 IndexedMesh UploadPositions(const TexturedMesh& mesh) {
   static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(Eigen::Vector3i) == 3 * sizeof(GLuint),
                 "uploaded as packed arrays");
@@ -129,14 +128,13 @@ IndexedMesh UploadShadedMesh(const TexturedMesh& mesh) {
 // mesh vertex holds its triangle's greatest height above the ground, so planar shadows can drop
 // the ground's own triangles without also dropping the foot of a wall.
 std::vector<Vertex> MeshVertices(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground) {
+  const std::vector<Eigen::Vector3f> normals = FaceNormals(mesh);
   std::vector<Vertex> vertices;
   vertices.reserve(mesh.triangles.size() * 3);
   const bool has_uv = mesh.corner_uvs.size() == mesh.triangles.size() * 3;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Eigen::Vector3i& tri = mesh.triangles[t];
-    Eigen::Vector3f normal =
-        (mesh.vertices[tri[1]] - mesh.vertices[tri[0]]).cross(mesh.vertices[tri[2]] - mesh.vertices[tri[0]]);
-    normal = normal.norm() > 0 ? Eigen::Vector3f(normal.normalized()) : Eigen::Vector3f::Zero();
+    const Eigen::Vector3f& normal = normals[t];
     float max_height = 0;
     for (int c = 0; c < 3 && ground; ++c) {
       max_height = std::max(max_height, static_cast<float>(ground->SignedDistance(mesh.vertices[tri[c]].cast<double>())));
