@@ -205,7 +205,7 @@ void BM_ClassifyAndFill(benchmark::State& state) {
     const auto start = std::chrono::steady_clock::now();
     const ClassMap classes = ClassifyPixels(blend, sources, target, {});
     const auto classified = std::chrono::steady_clock::now();
-    FillHoles(classes, {}, &blend);
+    FillHoles(classes, target.camera, {}, &blend);
     classify_ms += std::chrono::duration<double, std::milli>(classified - start).count();
     fill_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - classified).count();
     benchmark::DoNotOptimize(blend.color.Pixels().data());

@@ -1,21 +1,64 @@
 #include "reproject/background.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <stdexcept>
+#include <string>
 
 namespace parallax {
+namespace {
 
-std::vector<uint8_t> MarkBackground(const DepthMap& depth) {
+// Absolute allowance of the colour test, for dark pixels (linear light).
+constexpr float kDarkNoise = 0.002f;
+
+bool SimilarColor(const float* a, const float* b, float max_step) {
+  for (int c = 0; c < 3; ++c) {
+    if (!(std::abs(a[c] - b[c]) <= max_step * std::max(a[c], b[c]) + kDarkNoise)) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<uint8_t> MarkBackground(const DepthMap& depth, const Image& color, float max_step) {
   std::vector<uint8_t> background;
   std::vector<size_t> stack;
-  MarkBackground(depth, &background, &stack);
+  MarkBackground(depth, color, max_step, &background, &stack);
   return background;
 }
 
-void MarkBackground(const DepthMap& depth, std::vector<uint8_t>* background_out,
-                    std::vector<size_t>* stack_out) {
+void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
+                    std::vector<uint8_t>* background_out, std::vector<size_t>* stack_out) {
   const int width = depth.Width();
   const int height = depth.Height();
+  if (color.Width() != width || color.Height() != height || color.Channels() != 3) {
+    throw std::invalid_argument("MarkBackground: colour " + std::to_string(color.Width()) + "x" +
+                                std::to_string(color.Height()) + "x" +
+                                std::to_string(color.Channels()) + " does not match depth " +
+                                std::to_string(width) + "x" + std::to_string(height) + "x3");
+  }
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  const float* rgb = color.Pixels().data();
+  // A pixel next to one with depth lies on a silhouette, where the photo mixes the sky with
+  // the surface: it passes. Elsewhere, every neighbour must be of similar colour.
+  const auto smooth = [&](int x, int y) {
+    if (max_step >= 1) return true;
+    const int xs[4] = {x - 1, x + 1, x, x};
+    const int ys[4] = {y, y, y - 1, y + 1};
+    for (int k = 0; k < 4; ++k) {
+      if (xs[k] >= 0 && ys[k] >= 0 && xs[k] < width && ys[k] < height && depth.At(xs[k], ys[k]) != 0) {
+        return true;
+      }
+    }
+    const float* p = rgb + 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
+    for (int k = 0; k < 4; ++k) {
+      if (xs[k] < 0 || ys[k] < 0 || xs[k] >= width || ys[k] >= height) continue;
+      const float* q = rgb + 3 * (static_cast<size_t>(ys[k]) * static_cast<size_t>(width) + static_cast<size_t>(xs[k]));
+      if (!SimilarColor(p, q, max_step)) return false;
+    }
+    return true;
+  };
   std::vector<uint8_t>& background = *background_out;
   background.assign(count, 0);
   // Flood fill from the border; the stack holds each pixel at most once (marked on push), so
@@ -25,7 +68,7 @@ void MarkBackground(const DepthMap& depth, std::vector<uint8_t>* background_out,
   stack.reserve(count);
   const auto push = [&](int x, int y) {
     const size_t i = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-    if (background[i] == 0 && depth.At(x, y) == 0) {
+    if (background[i] == 0 && depth.At(x, y) == 0 && smooth(x, y)) {
       background[i] = 1;
       stack.push_back(i);
     }
@@ -48,6 +91,44 @@ void MarkBackground(const DepthMap& depth, std::vector<uint8_t>* background_out,
     if (y > 0) push(x, y - 1);
     if (y + 1 < height) push(x, y + 1);
   }
+}
+
+int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step) {
+  if (!(max_step > 0)) {
+    throw std::invalid_argument("RemoveDepthSpeckles: max_step " + std::to_string(max_step) +
+                                ": expected > 0");
+  }
+  const int width = depth->Width(), height = depth->Height();
+  float* values = depth->Values().data();
+  const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  std::vector<uint8_t> visited(count, 0);
+  std::vector<size_t> patch;  // The current patch, also the stack of its flood fill.
+  int cleared = 0;
+  for (size_t seed = 0; seed < count; ++seed) {
+    if (visited[seed] != 0 || values[seed] == 0) continue;
+    patch.assign(1, seed);
+    visited[seed] = 1;
+    for (size_t next = 0; next < patch.size(); ++next) {
+      const size_t i = patch[next];
+      const int x = static_cast<int>(i % static_cast<size_t>(width));
+      const int y = static_cast<int>(i / static_cast<size_t>(width));
+      const auto visit = [&](size_t j) {
+        if (visited[j] != 0 || values[j] == 0) return;
+        const float lo = std::min(values[i], values[j]), hi = std::max(values[i], values[j]);
+        if (!(hi <= lo * (1 + max_step))) return;
+        visited[j] = 1;
+        patch.push_back(j);
+      };
+      if (x > 0) visit(i - 1);
+      if (x + 1 < width) visit(i + 1);
+      if (y > 0) visit(i - static_cast<size_t>(width));
+      if (y + 1 < height) visit(i + static_cast<size_t>(width));
+    }
+    if (patch.size() > static_cast<size_t>(std::max(max_pixels, 0))) continue;
+    for (size_t i : patch) values[i] = 0;
+    cleared += static_cast<int>(patch.size());
+  }
+  return cleared;
 }
 
 }  // namespace parallax

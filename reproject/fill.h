@@ -4,6 +4,7 @@
 
 #include "reproject/blend.h"
 #include "reproject/holes.h"
+#include "reproject/view.h"
 
 namespace parallax {
 
@@ -43,9 +44,13 @@ struct FillSummary {
 // counts as farthest, except for holes, where it is taken only when no surface candidate is
 // found) within background_tolerance, and averages their colours weighted by inverse
 // distance; surface fills also get that averaged depth. A disocclusion is hidden
-// background, so its colour comes from the background side, not from the occluder. The
-// sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad options
-// or a class map of another size.
-FillSummary FillHoles(const ClassMap& classes, const FillOptions& options, BlendResult* blend);
+// background, so its colour comes from the background side, not from the occluder. Where the
+// background side is background at infinity, the colour comes from a sky model instead: an
+// affine function of the viewing ray through `camera` (the target's), fitted to the pixels
+// where background landed, so sky nothing saw continues the gradient of the sky around it.
+// The sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad
+// options, a non-pinhole camera, or a class map or camera of another size.
+FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillOptions& options,
+                      BlendResult* blend);
 
 }  // namespace parallax

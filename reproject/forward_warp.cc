@@ -396,6 +396,9 @@ void ForwardWarpOptions::Check() const {
   if (!(max_splat_px >= 1 && max_splat_px <= 64)) fail("max_splat_px", max_splat_px, "[1, 64]");
   if (!(splat_overlap >= 1 && splat_overlap <= 2)) fail("splat_overlap", splat_overlap, "[1, 2]");
   if (!(min_view_cos > 0 && min_view_cos < 1)) fail("min_view_cos", min_view_cos, "(0, 1)");
+  if (!(background_max_step > 0 && std::isfinite(background_max_step))) {
+    fail("background_max_step", background_max_step, "> 0");
+  }
 }
 
 void WarpBuffer::Reset(int width, int height) {
@@ -433,7 +436,8 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
   const int width = setup.src.width, height = setup.src.height;
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
   if (options.background_at_infinity) {
-    MarkBackground(source.depth, &data.background, &data.stack);
+    MarkBackground(source.depth, source.color, static_cast<float>(options.background_max_step),
+                   &data.background, &data.stack);
   } else {
     data.background.clear();
   }

@@ -32,9 +32,14 @@ struct ForwardWarpOptions {
   // Points are dropped when their target z is below this share of their distance from the
   // target centre (at or behind the camera plane, or projecting absurdly far out); in (0, 1).
   double min_view_cos = 1e-6;
-  // Depth-0 source pixels connected to the border (MarkBackground) are warped as directions
-  // and land as background at infinity; when false every depth-0 pixel is unknown.
+  // Depth-0 source pixels connected to the border through smooth colour (MarkBackground) are
+  // warped as directions and land as background at infinity; when false every depth-0 pixel
+  // is unknown.
   bool background_at_infinity = true;
+  // MarkBackground's colour test: the largest relative step between neighbouring background
+  // pixels (>= 1: no test). The sky's steps are well below 1%; textured ground the depth
+  // stage missed has larger ones and stays unknown instead of being warped to infinity.
+  double background_max_step = 0.05;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };

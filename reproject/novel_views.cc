@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+#include "reproject/background.h"
 #include "reproject/scene_views.h"
 
 namespace parallax {
@@ -177,6 +178,9 @@ const SourceView& SourceLibrary::Load(int index) {
     if (view->depth.Width() != view->color.Width() || view->depth.Height() != view->color.Height()) {
       throw BadInputError(paths_.DepthFor(name).string() + ": depth map and photo differ in size");
     }
+    // Specks of estimated depth would float in the sky; 1/2000 of the photo is ~150 pixels at
+    // 640x480. Ground-truth depth has none, so it is left as it was.
+    RemoveDepthSpeckles(&view->depth, view->depth.Width() * view->depth.Height() / 2000, 0.1f);
     CheckSourceView(*view);
     slot = std::move(view);
   }

@@ -66,7 +66,7 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
   result.timings.classify_ms = MsSince(step);
 
   step = Clock::now();
-  result.fill = FillHoles(result.classes, options.fill, &blend);
+  result.fill = FillHoles(result.classes, target.camera, options.fill, &blend);
   result.timings.fill_ms = MsSince(step);
 
   result.color = std::move(blend.color);

@@ -97,5 +97,44 @@ TEST(FillHoles, OutOfViewIsLeftWhenAsked) {
   EXPECT_NEAR(result.fill.hole_ratio_filled, result.metrics.out_of_view_ratio, 1e-12);
 }
 
+// A sky whose colour is affine in the direction (y is down: bluer upwards), seen by a source
+// looking level and rendered by a target pitched 12 degrees up: the target's top rows are
+// sky no source saw.
+TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
+  const Camera camera = MakePinholeCamera(1, 160, 120, 150, 150, 80, 60);
+  test::Scene scene;
+  scene.sky = [](const Eigen::Vector3d& d) {
+    return Eigen::Vector3f(0.5f + 0.3f * static_cast<float>(d.y()), 0.6f + 0.2f * static_cast<float>(d.y()),
+                           0.7f - 0.2f * static_cast<float>(d.y()));
+  };
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  const double pitch = 12 * test::kPi / 180;
+  const PosedCamera target =
+      CameraAt(camera, {0, 0, 0}, Eigen::Quaterniond(Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX())));
+  const RenderResult result = Render({&source}, target);
+  ASSERT_GT(result.metrics.out_of_view_ratio, 0.15);
+  double worst = 0, worst_edge_colour = 0;
+  int checked = 0;
+  for (int y = 0; y < 120; ++y) {
+    for (int x = 0; x < 160; ++x) {
+      if (result.classes.At(x, y) != PixelClass::kOutOfView) continue;
+      ++checked;
+      const Eigen::Vector3f truth = scene.sky(test::PixelRay(target, x, y).normalized());
+      // What the top row of sampled sky (the edge the old neighbour average copied) has.
+      const Eigen::Vector3f edge = scene.sky(test::PixelRay(source.Posed(), 80, 0).normalized());
+      for (int ch = 0; ch < 3; ++ch) {
+        worst = std::max(worst, static_cast<double>(std::abs(result.color.At(x, y, ch) - truth(ch))));
+        worst_edge_colour = std::max(worst_edge_colour, static_cast<double>(std::abs(edge(ch) - truth(ch))));
+      }
+      ASSERT_EQ(result.depth.At(x, y), 0);
+    }
+  }
+  EXPECT_GT(checked, 2000);
+  // The sky's colour is affine in the direction, so the model fits it up to float rounding
+  // and the bilinear resampling of the warped sky.
+  EXPECT_LT(worst, 0.003);
+  EXPECT_GT(worst_edge_colour, 0.02);  // What copying the edge would miss it by.
+}
+
 }  // namespace
 }  // namespace parallax
