@@ -118,6 +118,10 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
   }
   SourceLibrary library(gt_sources ? scene.Training() : SourcePathsFor(workspace));
   library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
+  if (!gt_sources) {
+    std::printf("novel views: depth holes %s\n",
+                UseMeshForDepthHoles(workspace, settings, &library).c_str());
+  }
   const std::filesystem::path comparison_dir =
       workspace / "evaluation" / (gt_sources ? "novel_gt_sources" : "novel");
   const NovelEvaluation result =

@@ -120,12 +120,16 @@ void RegisterRenderCommand(CLI::App& app) {
     }
     // What `reconstruct` would also make, and a request for novel views alone does not need.
     stages.push_back(Stage("fusion", "novel views warp each source's depth map; no fused cloud is needed"));
-    stages.push_back(Stage("mesh", "only novel views are requested: the Poisson mesh and its texture atlas "
-                                   "are for the viewer, and the warp does not use them"));
+    stages.push_back(Stage("mesh", "only novel views are requested: building the Poisson mesh and its "
+                                   "texture atlas for them would cost more than the holes it fills "
+                                   "(one that reconstruct made is used, see depth_holes)"));
     for (const std::string& name : library.DropViewsWithoutDepth()) {
       std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
                    name.c_str());
     }
+    const bool scene_folder = std::filesystem::is_directory(arguments->input / "gt");
+    const std::string depth_holes =
+        scene_folder ? "" : UseMeshForDepthHoles(arguments->input, arguments->settings, &library);
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
         "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
@@ -149,6 +153,18 @@ void RegisterRenderCommand(CLI::App& app) {
     stages.push_back(Stage("sources", "", "loaded " + std::to_string(library.LoadedCount()) + " of " +
                                               std::to_string(all_views) +
                                               " source views: the others can not contribute to these cameras"));
+    if (scene_folder) {
+      stages.push_back(Stage("depth_holes", "ground-truth depth has no holes"));
+    } else if (library.LoadedPixels() > 0 && depth_holes.starts_with("from ")) {
+      char share[32];
+      std::snprintf(share, sizeof share, "%.2f%%",
+                    100.0 * static_cast<double>(library.CompletedPixels()) /
+                        static_cast<double>(library.LoadedPixels()));
+      stages.push_back(Stage("depth_holes", "", "filled " + std::string(share) +
+                                                    " of the loaded sources' pixels " + depth_holes));
+    } else {
+      stages.push_back(Stage("depth_holes", depth_holes));
+    }
     std::string fill_skips;
     size_t skipped_views = 0;
     for (const auto& [reason, count] : fill_skipped) {

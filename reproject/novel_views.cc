@@ -181,6 +181,8 @@ const SourceView& SourceLibrary::Load(int index) {
     // Specks of estimated depth would float in the sky; 1/2000 of the photo is ~150 pixels at
     // 640x480. Ground-truth depth has none, so it is left as it was.
     RemoveDepthSpeckles(&view->depth, view->depth.Width() * view->depth.Height() / 2000, 0.1f);
+    if (completion_) completed_pixels_ += completion_(view->Posed(), &view->depth);
+    loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     CheckSourceView(*view);
     slot = std::move(view);
   }

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
 #include "core/image.h"
+#include "pipeline/textured_mesh.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 
@@ -25,6 +26,28 @@ std::vector<std::string> Lines(const std::string& text) {
   std::istringstream stream(text);
   for (std::string line; std::getline(stream, line);) lines.push_back(line);
   return lines;
+}
+
+std::map<std::string, nlohmann::json> ReportStages(const fs::path& out) {
+  const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(out / "report.json"));
+  std::map<std::string, nlohmann::json> stages;
+  for (const nlohmann::json& stage : report.at("render").at("stages")) stages[stage.at("name")] = stage;
+  return stages;
+}
+
+// Sum over render.csv's rows of the hole ratio before filling (third column).
+double HoleRatioSum(const fs::path& out) {
+  const std::vector<std::string> rows = Lines(ReadFileBytes(out / "render.csv"));
+  double sum = 0;
+  for (size_t i = 1; i < rows.size(); ++i) {
+    std::istringstream row(rows[i]);
+    std::string name, sources, ratio;
+    std::getline(row, name, ',');
+    std::getline(row, sources, ',');
+    std::getline(row, ratio, ',');
+    sum += std::stod(ratio);
+  }
+  return sum;
 }
 
 TEST(RenderCli, SceneFolderNovelCamerasWriteImagesMasksDepthAndCsv) {
@@ -69,9 +92,7 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_LE(maps, 4u) << "only the sources of two frames between 0003 and 0005";
   EXPECT_TRUE(fs::exists(dir.Path() / "out" / "between_0001.png"));
   // report.json says what ran and what was left out, and why: no fused cloud, no mesh or atlas.
-  const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(dir.Path() / "out" / "report.json"));
-  std::map<std::string, nlohmann::json> stages;
-  for (const nlohmann::json& stage : report.at("render").at("stages")) stages[stage.at("name")] = stage;
+  std::map<std::string, nlohmann::json> stages = ReportStages(dir.Path() / "out");
   EXPECT_FALSE(stages.at("depth").at("skipped").get<bool>());
   EXPECT_NE(stages.at("depth").at("reason").get<std::string>().find(" of 12 views"), std::string::npos);
   EXPECT_TRUE(stages.at("fusion").at("skipped").get<bool>());
@@ -79,6 +100,27 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_NE(stages.at("mesh").at("reason").get<std::string>().find("texture atlas"), std::string::npos);
   EXPECT_NE(stages.at("sources").at("reason").get<std::string>().find(" of 12 source views"), std::string::npos);
   EXPECT_FALSE(fs::exists(workspace / "mesh")) << "the atlas is never made for novel views";
+  EXPECT_TRUE(stages.at("depth_holes").at("skipped").get<bool>());
+  EXPECT_NE(stages.at("depth_holes").at("reason").get<std::string>().find("mesh.obj"), std::string::npos);
+
+  // With a mesh in the workspace (here the ground plane, z = 0 in the known cameras' frame),
+  // the pixels the depth maps have no depth for take the mesh's: fewer holes.
+  TexturedMesh ground;
+  ground.vertices = {{-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}};
+  ground.triangles = {{0, 1, 2}, {0, 2, 3}};
+  ground.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
+  ground.atlas = Image(2, 2, 3);
+  WriteTexturedMesh(workspace / "mesh", ground);
+  const CliResult with_mesh = RunParallax("render " + Quote(workspace.string()) +
+                                          " --path between:0003.png,0005.png,2 --sources 2 --out " +
+                                          Quote((dir.Path() / "out_mesh").string()));
+  ASSERT_EQ(with_mesh.exit_code, 0) << with_mesh.output;
+  stages = ReportStages(dir.Path() / "out_mesh");
+  EXPECT_FALSE(stages.at("depth_holes").at("skipped").get<bool>());
+  const std::string filled = stages.at("depth_holes").at("reason").get<std::string>();
+  EXPECT_EQ(filled.rfind("filled ", 0), 0u) << filled;
+  EXPECT_GT(std::stod(filled.substr(7)), 0.5) << filled;  // Percent of the sources' pixels.
+  EXPECT_LT(HoleRatioSum(dir.Path() / "out_mesh"), HoleRatioSum(dir.Path() / "out"));
 }
 
 TEST(RenderCli, BadInputExitsTwoAndNamesTheProblem) {
