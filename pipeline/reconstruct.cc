@@ -19,6 +19,7 @@
 #include "pipeline/sgbm.h"
 #include "pipeline/mvs.h"
 #include "pipeline/stage_cache.h"
+#include "pipeline/undistort.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -197,25 +198,28 @@ SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& 
   return aligned;
 }
 
-// What `colmap image_undistorter --output_type COLMAP` writes, for distortion-free cameras:
-// the photos as they are, the model with PINHOLE cameras, and the stereo/ folder layout with
-// the configuration files COLMAP's dense tools read.
-void CopyAsUndistorted(const SparseModel& model, const fs::path& photos_dir, const fs::path& output) {
+// What `colmap image_undistorter --output_type COLMAP` writes: the photos undistorted into
+// PINHOLE cameras of the same size and intrinsics (copied as they are where a camera has no
+// distortion; UndistortPhoto says why not COLMAP's resampling), the model with those cameras,
+// and the stereo/ folder layout with the configuration files COLMAP's dense tools read.
+void WritePinholeWorkspace(const SparseModel& model, const fs::path& photos_dir, const fs::path& output) {
   fs::create_directories(output / "images");
   fs::create_directories(output / "stereo" / "depth_maps");
   fs::create_directories(output / "stereo" / "normal_maps");
   fs::create_directories(output / "stereo" / "consistency_graphs");
   SparseModel pinhole;
-  for (const Camera& camera : model.Cameras()) {
-    pinhole.AddCamera(MakePinholeCamera(camera.id, camera.width, camera.height, camera.FocalX(),
-                                        camera.FocalY(), camera.PrincipalX(), camera.PrincipalY()));
-  }
+  for (const Camera& camera : model.Cameras()) pinhole.AddCamera(PinholeOf(camera));
   std::string patch_match, fusion;
   for (const SparseImage& image : model.Images()) {
     pinhole.AddImage(image);
     fs::create_directories((output / "images" / image.name).parent_path());
-    fs::copy_file(photos_dir / image.name, output / "images" / image.name,
-                  fs::copy_options::overwrite_existing);
+    const Camera& camera = model.CameraById(image.camera_id);
+    if (camera.HasDistortion()) {
+      UndistortPhoto(camera, photos_dir / image.name, output / "images" / image.name);
+    } else {
+      fs::copy_file(photos_dir / image.name, output / "images" / image.name,
+                    fs::copy_options::overwrite_existing);
+    }
     patch_match += image.name + "\n__auto__, 20\n";
     fusion += image.name + "\n";
   }
@@ -584,7 +588,8 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     }
   });
 
-  const std::string undistort_key = Hasher().Add(mapper_key).Hex();
+  // "undistort-2": our own resampling replaced image_undistorter's for supported models.
+  const std::string undistort_key = Hasher().Add(mapper_key).Add("undistort-2").Hex();
   if (options.dry_run) {
     stages.Run("undistort", undistort_key, paths.Sparse(), [] {});
     return summary;
@@ -634,16 +639,21 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   }
 
   // Undistortion into the workspace layout (PINHOLE images and model). Cameras without
-  // distortion need no resampling: the photos are copied as they are.
-  const bool distortion_free = std::none_of(raw_model.Cameras().begin(), raw_model.Cameras().end(),
-                                            [](const Camera& c) { return c.HasDistortion(); });
+  // distortion need no resampling: the photos are copied as they are. Models whose projection
+  // core implements are resampled by WritePinholeWorkspace; COLMAP's undistorter is left for
+  // the others (fisheye models).
+  const auto all_cameras = [&](const std::function<bool(const Camera&)>& test) {
+    return std::all_of(raw_model.Cameras().begin(), raw_model.Cameras().end(), test);
+  };
+  const bool distortion_free = all_cameras([](const Camera& c) { return !c.HasDistortion(); });
+  const bool supported = all_cameras([](const Camera& c) { return IsProjectionSupported(c.model); });
   stages.Run(
       "undistort", undistort_key, paths.Sparse(),
       [&] {
         const fs::path output = workspace / ".undistort.tmp";
         RemoveAll(output);
-        if (distortion_free) {
-          CopyAsUndistorted(raw_model, photos_dir, output);
+        if (supported) {
+          WritePinholeWorkspace(raw_model, photos_dir, output);
         } else {
           colmap.Run("image_undistorter",
                      {"--image_path", photos_dir.string(), "--input_path",
