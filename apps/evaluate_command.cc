@@ -5,6 +5,7 @@
 
 #include "apps/commands.h"
 #include "apps/render_options.h"
+#include "apps/terminal_progress.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/scene_folder.h"
@@ -14,6 +15,7 @@
 #include "pipeline/evaluate.h"
 #include "pipeline/mesh_evaluation.h"
 #include "pipeline/ply.h"
+#include "pipeline/register_held_out.h"
 #include "pipeline/textured_mesh.h"
 #include "reproject/novel_evaluation.h"
 
@@ -103,7 +105,8 @@ nlohmann::json EvaluateMesh(const std::filesystem::path& obj, const SparseModel&
 // with gt_sources, from the scene's own training views and depth; compared with the novel
 // images.
 nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::path& workspace,
-                             bool gt_sources, const Similarity3d& truth_from_estimate,
+                             bool gt_sources, bool register_poses,
+                             const Similarity3d& truth_from_estimate,
                              const NovelViewSettings& settings) {
   const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
   const Similarity3d estimate_from_truth =
@@ -115,6 +118,25 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
                        {novel.CameraById(image.camera_id),
                         estimate_from_truth.TransformPose(image.cam_from_world)}});
     names.push_back(image.name);
+  }
+  // Workspace sources: the novel cameras' poses by registering their photos into the SfM
+  // model (as novel-view benchmarks do), where that works; else from the alignment.
+  std::string poses = gt_sources ? "ground truth" : "aligned";
+  int registered = 0;
+  if (!gt_sources && register_poses) {
+    TerminalProgress progress;
+    const HeldOutRegistration registration = RegisterHeldOutPhotos(
+        workspace, scene.Novel().images, names, workspace / "evaluation" / "novel_registration",
+        progress);
+    for (size_t i = 0; i < names.size(); ++i) {
+      const auto found = registration.cam_from_world.find(names[i]);
+      if (found == registration.cam_from_world.end()) continue;
+      targets[i].camera.cam_from_world = found->second;
+      ++registered;
+    }
+    std::printf("novel camera poses: %s%s\n", registration.note.c_str(),
+                registered < static_cast<int>(names.size()) ? "; the others from the alignment" : "");
+    if (registered > 0) poses = "registered";
   }
   SourceLibrary library(gt_sources ? scene.Training() : SourcePathsFor(workspace));
   library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
@@ -146,7 +168,9 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
           {"background_ratio_mean", result.background_ratio_mean},
           {"hole_ratio_filled_mean", result.hole_ratio_filled_mean},
           {"ms_per_view", result.ms_per_view},
-          {"gt_sources", gt_sources}};
+          {"gt_sources", gt_sources},
+          {"poses", poses},
+          {"poses_registered", registered}};
 }
 
 }  // namespace
@@ -159,6 +183,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     bool no_align = false;
     bool gt_sources = false;
     bool novel_only = false;
+    std::string novel_poses = "registered";
     NovelViewSettings settings;
   };
   auto arguments = std::make_shared<Arguments>();
@@ -183,6 +208,12 @@ void RegisterEvaluateCommand(CLI::App& app) {
   command->add_flag("--novel-only", arguments->novel_only,
                     "evaluate the novel views only (with --gt-sources the workspace only "
                     "receives the comparison images)");
+  command->add_option("--novel-poses", arguments->novel_poses,
+                      "workspace sources: the novel cameras' poses from registering their photos "
+                      "into the SfM model with colmap image_registrator (registered, default; the "
+                      "photos give poses only) or from the ground truth through the pose "
+                      "alignment (aligned)")
+      ->check(CLI::IsMember({"registered", "aligned"}, CLI::ignore_case));
   AddRenderOptions(*command, arguments->settings);
   command->callback([arguments] {
     arguments->settings.Resolve();
@@ -241,6 +272,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
         (arguments->gt_sources || HasDepthMaps(depth_dir))) {
       json["novel"] = EvaluateNovel(
           scene, arguments->workspace, arguments->gt_sources,
+          arguments->novel_poses == "registered",
           arguments->no_align ? Similarity3d{} : evaluation.alignment.target_from_source,
           arguments->settings);
     }

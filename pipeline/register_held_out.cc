@@ -1,0 +1,101 @@
+#include "pipeline/register_held_out.h"
+
+#include <algorithm>
+#include <exception>
+
+#include "core/atomic_file.h"
+#include "core/hash.h"
+#include "core/sparse_model.h"
+#include "pipeline/colmap.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+
+HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::path& images_dir,
+                                          const std::vector<std::string>& names,
+                                          const fs::path& work_dir, Progress& progress) {
+  HeldOutRegistration result;
+  const fs::path database = workspace / "sfm" / "database.db";
+  const fs::path raw_model = workspace / "sfm" / "sparse";
+  if (!fs::exists(database) || !DetectSparseFormat(raw_model)) {
+    result.note = "no SfM database and model in " + (workspace / "sfm").string() +
+                  " (made from known cameras?)";
+    return result;
+  }
+  const SparseModel model = ReadSparseModel(raw_model);
+  std::string pairs;
+  for (const std::string& name : names) {
+    for (const SparseImage& image : model.Images()) {
+      if (image.name == name) {
+        result.note = name + " is also a training photo's name";
+        return result;
+      }
+      pairs += name + " " + image.name + "\n";
+    }
+  }
+  std::string list;
+  for (const std::string& name : names) list += name + "\n";
+  const std::string key = Hasher()
+                              .Add(list)
+                              .Add(ReadFileBytes(database))
+                              .Add(static_cast<uint64_t>(model.Images().size()))
+                              .Add(images_dir.string())
+                              .Hex();
+  const fs::path registered = work_dir / "model";
+  const fs::path key_file = work_dir / "key.txt";
+  const bool reuse = fs::exists(key_file) && ReadFileBytes(key_file) == key &&
+                     DetectSparseFormat(registered);
+  if (!reuse) {
+    try {
+      fs::remove_all(work_dir);
+      fs::create_directories(registered);
+      const fs::path db = work_dir / "database.db";
+      fs::copy_file(database, db);
+      WriteFileAtomically(work_dir / "image_list.txt", list);
+      WriteFileAtomically(work_dir / "pairs.txt", pairs);
+      const Colmap colmap;
+      const fs::path log = work_dir / "colmap.log";
+      const int count = static_cast<int>(names.size());
+      std::vector<std::string> extract = {
+          "--database_path", db.string(), "--image_path", images_dir.string(),
+          "--image_list_path", (work_dir / "image_list.txt").string(),
+          "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "2000",
+          "--SiftExtraction.max_num_features", "4096"};
+      // One shared camera (the usual capture): the held-out photos are taken with it.
+      if (model.Cameras().size() == 1) {
+        extract.insert(extract.end(), {"--ImageReader.existing_camera_id",
+                                       std::to_string(model.Cameras().front().id)});
+      } else {
+        extract.insert(extract.end(), {"--ImageReader.single_camera", "1"});
+      }
+      colmap.Run("feature_extractor", extract, log, "held-out features", count, progress);
+      colmap.Run("matches_importer",
+                 {"--database_path", db.string(), "--match_list_path",
+                  (work_dir / "pairs.txt").string(), "--match_type", "pairs",
+                  "--SiftMatching.use_gpu", "0"},
+                 log, "held-out matches", count, progress);
+      colmap.Run("image_registrator",
+                 {"--database_path", db.string(), "--input_path", raw_model.string(),
+                  "--output_path", registered.string()},
+                 log, "held-out registration", count, progress);
+      fs::remove(db);  // A copy of the workspace's, plus a few images: not worth keeping.
+      WriteFileAtomically(key_file, key);
+    } catch (const std::exception& e) {
+      result.note = std::string("colmap could not register them: ") + e.what();
+      return result;
+    }
+  }
+  const SparseModel with_held_out = ReadSparseModel(registered);
+  for (const SparseImage& image : with_held_out.Images()) {
+    if (std::find(names.begin(), names.end(), image.name) != names.end()) {
+      result.cam_from_world[image.name] = image.cam_from_world;
+    }
+  }
+  result.note = std::to_string(result.cam_from_world.size()) + " of " +
+                std::to_string(names.size()) +
+                " registered into the SfM model by colmap image_registrator" +
+                (reuse ? " (reused from " + work_dir.string() + ")" : " (" + work_dir.string() + ")");
+  return result;
+}
+
+}  // namespace parallax

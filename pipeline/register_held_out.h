@@ -1,0 +1,35 @@
+#pragma once
+// Poses of held-out photos (a scene's novel views) in a reconstruction's frame, the way
+// novel-view benchmarks get them: COLMAP registers the photos into the finished SfM model.
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/progress.h"
+
+namespace parallax {
+
+struct HeldOutRegistration {
+  std::map<std::string, Rigid3d> cam_from_world;  // By image name; the registered ones only.
+  std::string note;  // What was done (or reused), or why nothing was registered.
+};
+
+// Registers the photos `names` of `images_dir` into the SfM model of `workspace`
+// (<ws>/sfm/sparse and its database): SIFT features with the workspace's shared camera,
+// matched against every registered training photo, then `colmap image_registrator`, which
+// adds the photos without moving the training cameras (the depth maps stay valid). The photos'
+// pixels give their poses only; nothing is rendered from them. Aligning ground-truth poses
+// with a similarity instead carries the reconstruction's local pose errors into the
+// novel cameras (up to a pixel on the courtyard). Work and logs go to `work_dir`; a second
+// call with the same names and the same model reuses the result. Returns an empty map and
+// the reason when the workspace has no database (e.g. made from known cameras), a name is
+// also a training photo's, or COLMAP fails.
+HeldOutRegistration RegisterHeldOutPhotos(const std::filesystem::path& workspace,
+                                          const std::filesystem::path& images_dir,
+                                          const std::vector<std::string>& names,
+                                          const std::filesystem::path& work_dir,
+                                          Progress& progress);
+
+}  // namespace parallax
