@@ -54,6 +54,11 @@ void AddRenderOptions(CLI::App& command, NovelViewSettings& settings) {
   command.add_option("--sources", settings.selection.num_sources,
                      "source views per novel view: the best K by overlap and angle (default 4)")
       ->check(CLI::Range(1, 64));
+  command.add_option("--hole-sources", settings.selection.hole_sources,
+                     "at most this many more source views per novel view, added one at a time "
+                     "while holes remain, each the one that sees most of what they hide "
+                     "(default 2; 0: only the --sources best)")
+      ->check(CLI::Range(0, 16));
   command.add_option("--warp", settings.warp,
                      "forward warp: mesh (default; triangles, dropped across depth edges), splat "
                      "(points with a footprint) or naive (nearest pixel, the baseline)")

@@ -214,27 +214,74 @@ int SourceLibrary::LoadedCount() const {
   return count;
 }
 
+namespace {
+
+// Hole pixels are rendered again with one more source only while they make up this share of
+// the image: below it, another warp costs more than the few pixels it could fix.
+constexpr double kMinHoleRatioForMoreSources = 0.001;
+// A source is added only when at least this many of the sampled hole points lie in its frame.
+constexpr int kMinHolePointsInFrame = 32;
+// An added source must leave at most this share of the holes.
+constexpr double kKeptHoleShare = 0.9;
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedCamera& target) {
+  const Pinhole camera = Pinhole::From(target.camera);
+  const Rigid3d world_from_cam = target.cam_from_world.Inverse();
+  std::vector<Eigen::Vector3d> points;
+  for (int y = 0; y < result.classes.height; y += 2) {
+    for (int x = 0; x < result.classes.width; x += 2) {
+      const float depth = result.depth.At(x, y);
+      if (!IsHole(result.classes.At(x, y)) || !(depth > 0) || !std::isfinite(depth)) continue;
+      const double z = depth;
+      const Eigen::Vector3d in_camera((x + 0.5 - camera.cx) / camera.fx * z,
+                                      (y + 0.5 - camera.cy) / camera.fy * z, z);
+      points.push_back(world_from_cam * in_camera);
+    }
+  }
+  return points;
+}
+
 NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                           const SourceSelectionOptions& selection, const RenderOptions& options) {
   using Clock = std::chrono::steady_clock;
   const auto select_start = Clock::now();
-  const std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
+  std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
   const auto select_end = Clock::now();
   if (chosen.empty()) {
     throw BadInputError("render " + target.name + ": no source view sees what this camera sees");
   }
   NovelView view;
   std::vector<const SourceView*> sources;
-  for (int index : chosen) {
-    sources.push_back(&library.Load(index));
-    view.sources.push_back(library.Names()[static_cast<size_t>(index)]);
+  for (int index : chosen) sources.push_back(&library.Load(index));
+  Clock::duration spent = select_end - select_start;
+  Renderer renderer(options);
+  auto render_start = Clock::now();
+  view.result = renderer.Render(sources, target.camera);
+  spent += Clock::now() - render_start;
+  // More sources, one at a time, while holes remain and some source sees into them.
+  for (int extra = 0; extra < selection.hole_sources; ++extra) {
+    if (view.result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
+    const auto pick_start = Clock::now();
+    const int pick = SourceSeeingMost(library.Cameras(), target.camera,
+                                      HolePoints(view.result, target.camera), chosen,
+                                      kMinHolePointsInFrame, selection);
+    spent += Clock::now() - pick_start;
+    if (pick < 0) break;
+    const SourceView& source = library.Load(pick);
+    render_start = Clock::now();
+    RenderResult more = renderer.RenderWithOneMore(source);
+    spent += Clock::now() - render_start;
+    // Kept only when it closes a tenth of the holes at least: else it did not see into them
+    // after all (occluded as well), and the render without it stands.
+    if (!(more.metrics.hole_ratio < kKeptHoleShare * view.result.metrics.hole_ratio)) break;
+    chosen.push_back(pick);
+    view.result = std::move(more);
   }
-  const auto render_start = Clock::now();
-  view.result = Render(sources, target.camera, options);
+  for (int index : chosen) view.sources.push_back(library.Names()[static_cast<size_t>(index)]);
   // Selection and rendering; reading files is left out (the first targets pay for all).
-  view.ms = std::chrono::duration<double, std::milli>(Clock::now() - render_start +
-                                                      (select_end - select_start))
-                .count();
+  view.ms = std::chrono::duration<double, std::milli>(spent).count();
   return view;
 }
 

@@ -74,8 +74,15 @@ struct NovelView {
   double ms = 0;                     // Selection, warping, blending, classification, filling.
 };
 
-// Selects up to `selection.num_sources` sources for `target`, loads them, renders. Throws
-// BadInputError when no source can contribute to the target.
+// World points of a render's hole pixels (every other pixel of every other row) at the depth
+// the fill gave them: the background side of each hole, what the sources did not see.
+std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedCamera& target);
+
+// Selects up to `selection.num_sources` sources for `target`, loads them, renders; then, while
+// holes cover 0.1% of the image or more, adds up to `selection.hole_sources` more, one at a
+// time, each the source that sees most of HolePoints (SourceSeeingMost), kept when it closes a
+// tenth of the holes at least. Throws BadInputError when no source can contribute to the
+// target.
 NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                           const SourceSelectionOptions& selection, const RenderOptions& options);
 

@@ -34,7 +34,6 @@ RenderResult Render(const std::vector<const SourceView*>& sources, const TargetC
 RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
                               const TargetCamera& target) {
   const Clock::time_point start = Clock::now();
-  const RenderOptions& options = options_;
   if (sources.empty()) throw std::invalid_argument("Render: no source views");
   for (size_t i = 0; i < sources.size(); ++i) {
     if (sources[i] == nullptr) {
@@ -43,30 +42,45 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
     CheckSourceView(*sources[i]);
   }
   Pinhole::From(target.camera);  // Rejects a distorted target before any work.
-
-  RenderResult result;
+  sources_ = sources;
+  target_ = target;
   buffers_.resize(sources.size());
   scratch_.resize(sources.size());
   tbb::parallel_for(size_t{0}, sources.size(), [&](size_t i) {
-    ForwardWarp(*sources[i], target, options.warp, &buffers_[i], &scratch_[i]);
+    ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i]);
   });
-  result.timings.warp_ms = MsSince(start);
+  return Finish(start, MsSince(start));
+}
 
+RenderResult Renderer::RenderWithOneMore(const SourceView& source) {
+  const Clock::time_point start = Clock::now();
+  if (sources_.empty()) throw std::logic_error("Renderer::RenderWithOneMore before Render");
+  CheckSourceView(source);
+  sources_.push_back(&source);
+  buffers_.resize(sources_.size());
+  scratch_.resize(sources_.size());
+  ForwardWarp(source, target_, options_.warp, &buffers_.back(), &scratch_.back());
+  return Finish(start, MsSince(start));
+}
+
+RenderResult Renderer::Finish(Clock::time_point start, double warp_ms) {
+  RenderResult result;
+  result.timings.warp_ms = warp_ms;
   Clock::time_point step = Clock::now();
-  BlendResult blend = Blend(buffers_, options.blend);
+  BlendResult blend = Blend(buffers_, options_.blend);
   result.timings.blend_ms = MsSince(step);
 
   step = Clock::now();
   std::vector<ClassifySource> classify_sources;
-  for (size_t i = 0; i < sources.size(); ++i) {
-    classify_sources.push_back({sources[i]->Posed(), &sources[i]->depth, &scratch_[i].Background()});
+  for (size_t i = 0; i < sources_.size(); ++i) {
+    classify_sources.push_back({sources_[i]->Posed(), &sources_[i]->depth, &scratch_[i].Background()});
   }
-  result.classes = ClassifyPixels(blend, classify_sources, target, options.holes);
+  result.classes = ClassifyPixels(blend, classify_sources, target_, options_.holes);
   result.metrics = ComputeHoleMetrics(result.classes);
   result.timings.classify_ms = MsSince(step);
 
   step = Clock::now();
-  result.fill = FillHoles(result.classes, target.camera, options.fill, &blend);
+  result.fill = FillHoles(result.classes, target_.camera, options_.fill, &blend);
   result.timings.fill_ms = MsSince(step);
 
   result.color = std::move(blend.color);

@@ -1,6 +1,7 @@
 #pragma once
 // Novel-view rendering by depth-image-based warping: warp every source, blend, classify the
 // pixels nothing reached, fill the holes.
+#include <chrono>
 #include <vector>
 
 #include "core/depth_map.h"
@@ -50,10 +51,21 @@ class Renderer {
   // As the free function Render below.
   RenderResult Render(const std::vector<const SourceView*>& sources, const TargetCamera& target);
 
+  // Renders the last Render's target again with `source` added to its sources: only `source`
+  // is warped, the others' warps are kept (blending, classification and filling run again).
+  // `source` and the last call's sources must outlive the next call. Throws std::logic_error
+  // before any Render, std::invalid_argument like Render for a bad source.
+  RenderResult RenderWithOneMore(const SourceView& source);
+
  private:
+  // Blends the warped buffers, classifies and fills; `start` is when the render began.
+  RenderResult Finish(std::chrono::steady_clock::time_point start, double warp_ms);
+
   RenderOptions options_;
   std::vector<WarpBuffer> buffers_;
   std::vector<WarpScratch> scratch_;
+  std::vector<const SourceView*> sources_;  // Of the last render.
+  TargetCamera target_;
 };
 
 // Renders `target` from `sources` (at least one; each checked with CheckSourceView). Sources

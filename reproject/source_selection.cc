@@ -130,6 +130,7 @@ void SourceSelectionOptions::Check() const {
   if (grid_rows < 1) fail("grid_rows", grid_rows, ">= 1");
   if (!(min_overlap > 0 && min_overlap <= 1)) fail("min_overlap", min_overlap, "(0, 1]");
   if (!(angle_scale_deg > 0 && std::isfinite(angle_scale_deg))) fail("angle_scale_deg", angle_scale_deg, "> 0");
+  if (hole_sources < 0) fail("hole_sources", hole_sources, ">= 0");
   if (!(diversity_angle_deg >= 0 && diversity_angle_deg <= 180)) {
     fail("diversity_angle_deg", diversity_angle_deg, "[0, 180]");
   }
@@ -184,6 +185,38 @@ std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const Po
     candidates.erase(candidates.begin() + static_cast<std::ptrdiff_t>(best));
   }
   return chosen;
+}
+
+int SourceSeeingMost(const std::vector<PosedCamera>& sources, const PosedCamera& target,
+                     const std::vector<Eigen::Vector3d>& points, const std::vector<int>& exclude,
+                     int min_points, const SourceSelectionOptions& options) {
+  options.Check();
+  const Eigen::Vector3d target_center = CameraCenter(target.cam_from_world);
+  int best = -1;
+  double best_score = 0;
+  for (size_t i = 0; i < sources.size(); ++i) {
+    if (std::find(exclude.begin(), exclude.end(), static_cast<int>(i)) != exclude.end()) continue;
+    const Pinhole s = Pinhole::From(sources[i].camera);
+    const Rigid3d& cam_from_world = sources[i].cam_from_world;
+    const Eigen::Vector3d center = CameraCenter(cam_from_world);
+    int inside = 0;
+    double score = 0;
+    for (const Eigen::Vector3d& point : points) {
+      const Eigen::Vector3d p = cam_from_world * point;
+      if (!(p.z() > 1e-9 * p.norm())) continue;
+      const double u = s.fx * p.x() / p.z() + s.cx, v = s.fy * p.y() / p.z() + s.cy;
+      if (!(u >= 0 && v >= 0 && u <= s.width && v <= s.height)) continue;
+      ++inside;
+      const double cos_angle = (center - point).normalized().dot((target_center - point).normalized());
+      const double angle_deg = std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+      score += 1 / (1 + angle_deg / options.angle_scale_deg);
+    }
+    if (inside >= min_points && score > best_score) {
+      best_score = score;
+      best = static_cast<int>(i);
+    }
+  }
+  return best;
 }
 
 }  // namespace parallax

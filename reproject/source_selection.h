@@ -26,6 +26,10 @@ struct SourceSelectionOptions {
   // from another source seeing it from there, so later picks favour other directions and
   // see behind what the first ones' views hide. 0: plain score order. In [0, 180].
   double diversity_angle_deg = 10;
+  // RenderNovelView: after rendering from the chosen sources, up to this many more are added
+  // one at a time while holes remain, each the source that sees most of the holes' hidden
+  // surface (SourceSeeingMost); >= 0.
+  int hole_sources = 2;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
@@ -51,5 +55,15 @@ std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
 // bad options.
 std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
                                const SourceSelectionOptions& options);
+
+// Index of the source that best sees `points` (world points nobody chosen saw, e.g. the
+// background behind a render's holes at the depth the fill gave them): the largest sum over
+// the points inside its frame and in front of it of 1 / (1 + angle / angle_scale_deg), the
+// angle between its ray and the target's at the point. Sources in `exclude` are skipped;
+// occlusion is not known before a source is loaded, so a pick can still fail to see them.
+// Returns -1 when no source has at least min_points points inside its frame.
+int SourceSeeingMost(const std::vector<PosedCamera>& sources, const PosedCamera& target,
+                     const std::vector<Eigen::Vector3d>& points, const std::vector<int>& exclude,
+                     int min_points, const SourceSelectionOptions& options);
 
 }  // namespace parallax

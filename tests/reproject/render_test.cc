@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "reproject/novel_views.h"
+#include "reproject/source_selection.h"
 #include "tests/reproject/analytic_scene.h"
 
 namespace parallax {
@@ -158,6 +160,46 @@ TEST(Render, TwoSourcesOnEitherSideShrinkTheHoles) {
     });
     EXPECT_GE(psnr, 30);
   }
+}
+
+// One more source added to a render warps only that source and gives what rendering all of
+// them at once gives.
+TEST(Renderer, RenderWithOneMoreEqualsRenderingAllSources) {
+  const Scene scene = BoxScene();
+  const SourceView left = test::RenderView(scene, CameraAt(BoxCamera(), {-0.6, 0, 0}), "left");
+  const SourceView right = test::RenderView(scene, CameraAt(BoxCamera(), {0.6, 0, 0}), "right");
+  const SourceView up = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0.5, 0}), "up");
+  const PosedCamera target = CameraAt(BoxCamera(), {0, 0.05, 0});
+  Renderer renderer(Options(WarpMethod::kMesh, FillMethod::kDepthAware));
+  EXPECT_THROW(renderer.RenderWithOneMore(up), std::logic_error);
+  renderer.Render({&left, &right}, target);
+  const RenderResult added = renderer.RenderWithOneMore(up);
+  const RenderResult all = Render({&left, &right, &up}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
+  EXPECT_EQ(added.color.Pixels(), all.color.Pixels());
+  EXPECT_EQ(added.depth.Values(), all.depth.Values());
+  EXPECT_EQ(added.metrics.hole_ratio, all.metrics.hole_ratio);
+}
+
+// The hole a box leaves in a render from its left lies behind the box: of three more
+// cameras, the one to the right sees it, one further left and one looking away do not.
+TEST(SourceSeeingMost, PicksTheViewThatSeesBehindTheOccluder) {
+  const Scene scene = BoxScene();
+  const SourceView left = test::RenderView(scene, CameraAt(BoxCamera(), {-0.6, 0, 0}), "left");
+  const PosedCamera target = CameraAt(BoxCamera(), {0, 0.05, 0});
+  const RenderResult result = Render({&left}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
+  const std::vector<Eigen::Vector3d> points = HolePoints(result, target);
+  ASSERT_GT(points.size(), 500u);
+  for (const Eigen::Vector3d& point : points) ASSERT_NEAR(point.z(), 8, 0.1);  // The wall.
+  const Eigen::Quaterniond away(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  const std::vector<PosedCamera> candidates = {CameraAt(BoxCamera(), {-1.2, 0, 0}),
+                                               CameraAt(BoxCamera(), {0, 0, 0}, away),
+                                               CameraAt(BoxCamera(), {0.6, 0, 0})};
+  const SourceSelectionOptions options;
+  EXPECT_EQ(SourceSeeingMost(candidates, target, points, {}, 32, options), 2);
+  // Without it, the one further left still has the points in its frame (it is occluded too,
+  // which is not known before it is loaded); the one looking away never does.
+  EXPECT_EQ(SourceSeeingMost(candidates, target, points, {2}, 32, options), 0);
+  EXPECT_EQ(SourceSeeingMost(candidates, target, points, {0, 2}, 32, options), -1);
 }
 
 // A target below the source and tilted up sees sky above the source's frame. At finite depth
