@@ -180,25 +180,31 @@ void Bench::Render() {
     std::string warp;
     int sources;
     std::string fill;
+    int hole_sources = 0;  // More sources while holes remain (render --hole-sources).
     bool baseline = false;
   };
   std::vector<Setting> settings;
   for (const std::string warp : {"mesh", "splat"}) {
     for (int sources : {1, 2, 4, 6}) settings.push_back({warp, sources, "depth-aware"});
   }
+  settings.push_back({"mesh", 4, "depth-aware", 1});
+  settings.push_back({"mesh", 4, "depth-aware", 2});  // The default.
   settings.push_back({"mesh", 4, "none"});
   settings.push_back({"mesh", 4, "inpaint"});
-  settings.push_back({"naive", 1, "inpaint", true});
+  settings.push_back({"naive", 1, "inpaint", 0, true});
   for (const Setting& setting : settings) {
-    const std::string id = setting.warp + "_k" + std::to_string(setting.sources) + "_" + setting.fill;
+    const std::string id = setting.warp + "_k" + std::to_string(setting.sources) + "_h" +
+                           std::to_string(setting.hole_sources) + "_" + setting.fill;
     ChildRun run;
     const nlohmann::json json = Evaluate(
         "render_" + id, KnownWorkspace(),
-        {"--gt-sources", "--novel-only", "--sources", std::to_string(setting.sources), "--warp",
-         setting.warp, "--fill", setting.fill},
+        {"--gt-sources", "--novel-only", "--sources", std::to_string(setting.sources),
+         "--hole-sources", std::to_string(setting.hole_sources), "--warp", setting.warp,
+         "--fill", setting.fill},
         &run);
     rows.push_back({"render", setting.baseline ? "naive" : "parallax",
-                    "warp=" + setting.warp + " K=" + std::to_string(setting.sources) + " fill=" + setting.fill,
+                    "warp=" + setting.warp + " K=" + std::to_string(setting.sources) +
+                        " hole-sources=" + std::to_string(setting.hole_sources) + " fill=" + setting.fill,
                     {{"psnr", At(json, "novel", "psnr_mean")},
                      {"ssim", At(json, "novel", "ssim_mean")},
                      {"psnr_valid", At(json, "novel", "psnr_valid_mean")},
