@@ -142,7 +142,7 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
   library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
   if (!gt_sources) {
     std::printf("novel views: depth holes %s\n",
-                UseMeshForDepthHoles(workspace, settings, &library).c_str());
+                PrepareWorkspaceDepth(workspace, settings, &library).note.c_str());
   }
   const std::filesystem::path comparison_dir =
       workspace / "evaluation" / (gt_sources ? "novel_gt_sources" : "novel");

@@ -23,12 +23,15 @@ std::string CsvRow(const std::string& name, const NovelView& view) {
   std::string sources;
   for (const std::string& source : view.sources) sources += (sources.empty() ? "" : " ") + source;
   const std::string fill = view.result.fill.skipped.empty() ? "ran" : "skipped: " + view.result.fill.skipped;
-  char row[512];
-  std::snprintf(row, sizeof(row), "%s,%s,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%d,%s,%.2f\n", name.c_str(),
-                sources.c_str(), m.hole_ratio, view.result.fill.hole_ratio_filled, m.crack_ratio,
+  char numbers[256];
+  std::snprintf(numbers, sizeof(numbers), ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%d,",
+                m.hole_ratio, view.result.fill.hole_ratio_filled, m.crack_ratio,
                 m.disocclusion_ratio, m.out_of_view_ratio, m.background_ratio, m.hole_count,
-                m.largest_hole_px, fill.c_str(), view.ms);
-  return row;
+                m.largest_hole_px);
+  char ms[32];
+  std::snprintf(ms, sizeof(ms), ",%.2f\n", view.ms);
+  // Names and the fill's reason can be long: no fixed-size buffer for them.
+  return name + "," + sources + numbers + fill + ms;
 }
 
 // A stage of the request, as report.json lists it: run, or skipped and why.
@@ -128,8 +131,9 @@ void RegisterRenderCommand(CLI::App& app) {
                    name.c_str());
     }
     const bool scene_folder = std::filesystem::is_directory(arguments->input / "gt");
-    const std::string depth_holes =
-        scene_folder ? "" : UseMeshForDepthHoles(arguments->input, arguments->settings, &library);
+    const WorkspaceDepthPreparation depth_holes =
+        scene_folder ? WorkspaceDepthPreparation{}
+                     : PrepareWorkspaceDepth(arguments->input, arguments->settings, &library);
     std::string csv =
         "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
         "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
@@ -155,15 +159,15 @@ void RegisterRenderCommand(CLI::App& app) {
                                               " source views: the others can not contribute to these cameras"));
     if (scene_folder) {
       stages.push_back(Stage("depth_holes", "ground-truth depth has no holes"));
-    } else if (library.LoadedPixels() > 0 && depth_holes.starts_with("from ")) {
+    } else if (library.LoadedPixels() > 0 && depth_holes.mesh) {
       char share[32];
       std::snprintf(share, sizeof share, "%.2f%%",
-                    100.0 * static_cast<double>(library.CompletedPixels()) /
+                    100.0 * static_cast<double>(library.PreparedPixels()) /
                         static_cast<double>(library.LoadedPixels()));
       stages.push_back(Stage("depth_holes", "", "filled " + std::string(share) +
-                                                    " of the loaded sources' pixels " + depth_holes));
+                                                    " of the loaded sources' pixels " + depth_holes.note));
     } else {
-      stages.push_back(Stage("depth_holes", depth_holes));
+      stages.push_back(Stage("depth_holes", depth_holes.note));
     }
     std::string fill_skips;
     size_t skipped_views = 0;

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "pipeline/raycaster.h"
+#include "reproject/background.h"
 #include "pipeline/textured_mesh.h"
 
 namespace parallax {
@@ -20,19 +21,32 @@ void NovelViewSettings::Resolve() {
   }
 }
 
-std::string UseMeshForDepthHoles(const std::filesystem::path& workspace,
-                                 const NovelViewSettings& settings, SourceLibrary* library) {
-  if (settings.depth_holes == "none") return "not requested (--depth-holes none)";
+WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& workspace,
+                                                const NovelViewSettings& settings,
+                                                SourceLibrary* library) {
+  WorkspaceDepthPreparation result;
   const std::filesystem::path obj = workspace / "mesh" / "mesh.obj";
-  if (!std::filesystem::exists(obj)) {
-    return "no " + obj.string() + " (reconstruct makes it; render does not build one for this)";
+  std::shared_ptr<const MeshRaycaster> caster;
+  if (settings.depth_holes == "none") {
+    result.note = "not requested (--depth-holes none)";
+  } else if (!std::filesystem::exists(obj)) {
+    result.note = "no " + obj.string() + " (reconstruct makes it; render does not build one for this)";
+  } else {
+    const TexturedMesh mesh = ReadTexturedMesh(obj);
+    caster = std::make_shared<const MeshRaycaster>(mesh.vertices, mesh.triangles);
+    result.mesh = true;
+    result.note = "from " + obj.string() + " (" + std::to_string(mesh.triangles.size()) + " triangles)";
   }
-  const TexturedMesh mesh = ReadTexturedMesh(obj);
-  auto caster = std::make_shared<const MeshRaycaster>(mesh.vertices, mesh.triangles);
-  library->SetDepthCompletion([caster](const PosedCamera& camera, DepthMap* depth) {
-    const std::vector<RayHit> hits = caster->CastPixels(camera.camera, camera.cam_from_world);
-    std::vector<float>& values = depth->Values();
+  library->SetDepthPreparation([caster](SourceView* view) {
+    DepthMap& depth = view->depth;
+    RemoveDepthSpeckles(&depth, depth.Width() * depth.Height() / 2000, 0.1f);
+    if (!caster) return 0;
+    const std::vector<RayHit> hits = caster->CastPixels(view->camera, view->cam_from_world);
+    std::vector<float>& values = depth.Values();
     if (hits.size() != values.size()) return 0;
+    // Every depth-0 pixel the mesh covers, sky-coloured ones too: keeping those that
+    // MarkBackground calls sky out of the fill cost 0.2 dB on the courtyard (27.15 -> 26.93):
+    // the mesh is right there more often than a smooth colour is sky.
     int filled = 0;
     for (size_t i = 0; i < hits.size(); ++i) {
       const float z = hits[i].depth;
@@ -42,7 +56,7 @@ std::string UseMeshForDepthHoles(const std::filesystem::path& workspace,
     }
     return filled;
   });
-  return "from " + obj.string() + " (" + std::to_string(mesh.triangles.size()) + " triangles)";
+  return result;
 }
 
 void AddRenderOptions(CLI::App& command, NovelViewSettings& settings) {

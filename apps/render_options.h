@@ -1,5 +1,6 @@
 #pragma once
-// The novel-view knobs `render` and `evaluate` share: --sources, --warp, --fill.
+// The novel-view knobs `render` and `evaluate` share (--sources, --hole-sources, --warp,
+// --fill, --depth-holes), and how a workspace's depth maps are prepared for warping.
 #include <filesystem>
 #include <string>
 
@@ -26,10 +27,19 @@ struct NovelViewSettings {
 
 void AddRenderOptions(CLI::App& command, NovelViewSettings& settings);
 
-// With depth_holes "mesh" and <workspace>/mesh/mesh.obj present, makes `library` fill each
-// source's depth holes with the mesh's depth (Embree, one ray per pixel, when the view is
-// loaded). Returns what it did or why not, for the log and render's report.json.
-std::string UseMeshForDepthHoles(const std::filesystem::path& workspace,
-                                 const NovelViewSettings& settings, SourceLibrary* library);
+struct WorkspaceDepthPreparation {
+  bool mesh = false;  // Depth holes take the mesh's depth.
+  std::string note;   // What that means, or why the mesh is not used.
+};
+
+// Makes `library` prepare each workspace source's estimated depth map as it is loaded: specks
+// removed (RemoveDepthSpeckles: patches under 1/2000 of the photo, ~700 per courtyard view,
+// which would float in the sky and be smeared into streaks by the fill), then, with
+// depth_holes "mesh" and <workspace>/mesh/mesh.obj present, the depth-0 pixels the mesh covers
+// take its depth (Embree, one ray per pixel): estimated depth maps lack depth where matching
+// failed (~12% of the courtyard's photos).
+WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& workspace,
+                                                const NovelViewSettings& settings,
+                                                SourceLibrary* library);
 
 }  // namespace parallax

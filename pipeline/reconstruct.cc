@@ -588,8 +588,14 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     }
   });
 
-  // "undistort-2": our own resampling replaced image_undistorter's for supported models.
-  const std::string undistort_key = Hasher().Add(mapper_key).Add("undistort-2").Hex();
+  // "undistort-2": our own resampling replaced image_undistorter's for supported models; models
+  // without distortion parameters copy the photos as before, and keep their key (and depth).
+  const bool may_distort =
+      camera.model != CameraModel::kPinhole && camera.model != CameraModel::kSimplePinhole;
+  Hasher undistort_hasher;
+  undistort_hasher.Add(mapper_key);
+  if (may_distort) undistort_hasher.Add("undistort-2");
+  const std::string undistort_key = undistort_hasher.Hex();
   if (options.dry_run) {
     stages.Run("undistort", undistort_key, paths.Sparse(), [] {});
     return summary;

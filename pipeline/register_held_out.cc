@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <exception>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "core/hash.h"
 #include "core/sparse_model.h"
 #include "pipeline/colmap.h"
+#include "pipeline/colmap_database.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -23,24 +25,24 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
     return result;
   }
   const SparseModel model = ReadSparseModel(raw_model);
-  std::string pairs;
+  // Photos the database holds already (registered or not) would be taken for these.
+  const std::map<std::string, DatabaseImage> in_database = ReadDatabaseImages(database);
+  std::string pairs, list;
+  Hasher key_hasher;
+  key_hasher.Add("held-out-1").Add(static_cast<uint64_t>(fs::file_size(database)));
+  std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
+  std::sort(model_files.begin(), model_files.end());
+  for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
   for (const std::string& name : names) {
-    for (const SparseImage& image : model.Images()) {
-      if (image.name == name) {
-        result.note = name + " is also a training photo's name";
-        return result;
-      }
-      pairs += name + " " + image.name + "\n";
+    if (in_database.contains(name)) {
+      result.note = name + " is also a training photo's name";
+      return result;
     }
+    for (const SparseImage& image : model.Images()) pairs += name + " " + image.name + "\n";
+    list += name + "\n";
+    key_hasher.Add(name).Add(ReadFileBytes(images_dir / name));
   }
-  std::string list;
-  for (const std::string& name : names) list += name + "\n";
-  const std::string key = Hasher()
-                              .Add(list)
-                              .Add(ReadFileBytes(database))
-                              .Add(static_cast<uint64_t>(model.Images().size()))
-                              .Add(images_dir.string())
-                              .Hex();
+  const std::string key = key_hasher.Hex();
   const fs::path registered = work_dir / "model";
   const fs::path key_file = work_dir / "key.txt";
   const bool reuse = fs::exists(key_file) && ReadFileBytes(key_file) == key &&

@@ -100,8 +100,8 @@ class WarpScratch {
 
   struct Data;  // Defined in forward_warp.cc.
   Data& Get() { return *data_; }
-  // MarkBackground of the last warped source's depth; empty when it did not use background
-  // at infinity.
+  // MarkBackground of the last warped source's depth and colour; empty when it did not use
+  // background at infinity.
   const std::vector<uint8_t>& Background() const;
 
  private:

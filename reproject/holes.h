@@ -65,7 +65,8 @@ struct ClassifySource {
   PosedCamera camera;
   // Its depth map (camera size); null: only its frustum is known (no free-space test).
   const DepthMap* depth = nullptr;
-  // MarkBackground of `depth` (background at infinity, seen as empty space at every depth);
+  // MarkBackground of `depth` and the source's colour (background at infinity, seen as empty
+  // space at every depth);
   // null or empty: every depth-0 pixel is unknown.
   const std::vector<uint8_t>* background = nullptr;
 };

@@ -12,7 +12,6 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
-#include "reproject/background.h"
 #include "reproject/scene_views.h"
 
 namespace parallax {
@@ -178,10 +177,7 @@ const SourceView& SourceLibrary::Load(int index) {
     if (view->depth.Width() != view->color.Width() || view->depth.Height() != view->color.Height()) {
       throw BadInputError(paths_.DepthFor(name).string() + ": depth map and photo differ in size");
     }
-    // Specks of estimated depth would float in the sky; 1/2000 of the photo is ~150 pixels at
-    // 640x480. Ground-truth depth has none, so it is left as it was.
-    RemoveDepthSpeckles(&view->depth, view->depth.Width() * view->depth.Height() / 2000, 0.1f);
-    if (completion_) completed_pixels_ += completion_(view->Posed(), &view->depth);
+    if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     CheckSourceView(*view);
     slot = std::move(view);
@@ -234,10 +230,7 @@ std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedC
     for (int x = 0; x < result.classes.width; x += 2) {
       const float depth = result.depth.At(x, y);
       if (!IsHole(result.classes.At(x, y)) || !(depth > 0) || !std::isfinite(depth)) continue;
-      const double z = depth;
-      const Eigen::Vector3d in_camera((x + 0.5 - camera.cx) / camera.fx * z,
-                                      (y + 0.5 - camera.cy) / camera.fy * z, z);
-      points.push_back(world_from_cam * in_camera);
+      points.push_back(world_from_cam * (camera.PixelRay(x, y) * static_cast<double>(depth)));
     }
   }
   return points;
@@ -261,7 +254,8 @@ NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   view.result = renderer.Render(sources, target.camera);
   spent += Clock::now() - render_start;
   // More sources, one at a time, while holes remain and some source sees into them.
-  for (int extra = 0; extra < selection.hole_sources; ++extra) {
+  const int hole_sources = options.fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
+  for (int extra = 0; extra < hole_sources; ++extra) {
     if (view.result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
     const auto pick_start = Clock::now();
     const int pick = SourceSeeingMost(library.Cameras(), target.camera,

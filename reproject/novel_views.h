@@ -45,14 +45,13 @@ class SourceLibrary {
   // Throws BadInputError naming the file for a missing or corrupt photo or depth map.
   const SourceView& Load(int index);
   int LoadedCount() const;
-  // Gives depth to the pixels of each loaded view's depth map that have none, from a model of
-  // the whole scene (`parallax render` passes the workspace's mesh): returns how many it
-  // filled. Estimated depth maps leave holes where matching failed (~12% of the courtyard's
-  // photos); warped, those are holes in every novel view. Call before any Load.
-  using DepthCompletion = std::function<int(const PosedCamera& camera, DepthMap* depth)>;
-  void SetDepthCompletion(DepthCompletion completion) { completion_ = std::move(completion); }
-  // Pixels filled by the completion so far, and all pixels of the views loaded.
-  long CompletedPixels() const { return completed_pixels_; }
+  // Runs on each view as it is loaded, before it is warped, to prepare its depth map (for a
+  // workspace's estimated depth: specks out, holes from the mesh; see apps/render_options.h);
+  // returns how many pixels it gave depth. Call before any Load.
+  using DepthPreparation = std::function<int(SourceView* view)>;
+  void SetDepthPreparation(DepthPreparation preparation) { preparation_ = std::move(preparation); }
+  // Pixels the preparation gave depth so far, and all pixels of the views loaded.
+  long PreparedPixels() const { return prepared_pixels_; }
   long LoadedPixels() const { return loaded_pixels_; }
   // Leaves out the views without a depth map on disk (their depth could not be estimated, e.g.
   // no stereo partner); returns their names. Call before any Load.
@@ -63,8 +62,8 @@ class SourceLibrary {
   std::vector<PosedCamera> cameras_;
   std::vector<std::string> names_;
   std::vector<std::unique_ptr<SourceView>> loaded_;
-  DepthCompletion completion_;
-  long completed_pixels_ = 0;
+  DepthPreparation preparation_;
+  long prepared_pixels_ = 0;
   long loaded_pixels_ = 0;
 };
 
@@ -80,9 +79,11 @@ std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedC
 
 // Selects up to `selection.num_sources` sources for `target`, loads them, renders; then, while
 // holes cover 0.1% of the image or more, adds up to `selection.hole_sources` more, one at a
-// time, each the source that sees most of HolePoints (SourceSeeingMost), kept when it closes a
-// tenth of the holes at least. Throws BadInputError when no source can contribute to the
-// target.
+// time, each the source that sees most of HolePoints (SourceSeeingMost); it stops at the first
+// that does not close a tenth of the holes (that one stays loaded, unused). HolePoints needs
+// the depth the depth-aware fill gives holes: with another fill no source is added. The
+// result's timings are those of its last render step; NovelView::ms covers them all. Throws
+// BadInputError when no source can contribute to the target.
 NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                           const SourceSelectionOptions& selection, const RenderOptions& options);
 

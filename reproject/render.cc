@@ -56,10 +56,10 @@ RenderResult Renderer::RenderWithOneMore(const SourceView& source) {
   const Clock::time_point start = Clock::now();
   if (sources_.empty()) throw std::logic_error("Renderer::RenderWithOneMore before Render");
   CheckSourceView(source);
-  sources_.push_back(&source);
-  buffers_.resize(sources_.size());
-  scratch_.resize(sources_.size());
+  buffers_.resize(sources_.size() + 1);
+  scratch_.resize(sources_.size() + 1);
   ForwardWarp(source, target_, options_.warp, &buffers_.back(), &scratch_.back());
+  sources_.push_back(&source);  // Only once warped: a throw leaves the last render's state.
   return Finish(start, MsSince(start));
 }
 

@@ -48,6 +48,11 @@ struct Pinhole {
   // Throws std::invalid_argument naming the camera id for distortion, a projection the
   // pinhole model cannot express, a size beyond int, or a non-positive focal length.
   static Pinhole From(const Camera& camera);
+
+  // The ray (x', y', 1) through the centre of pixel (x, y), in the camera frame.
+  Eigen::Vector3d PixelRay(int x, int y) const {
+    return Eigen::Vector3d((x + 0.5 - cx) / fx, (y + 0.5 - cy) / fy, 1);
+  }
 };
 
 // Throws std::invalid_argument naming the view when the camera is not pinhole, the colour is

@@ -49,9 +49,15 @@ TEST(BenchCli, SmallSceneReportsEveryStageAgainstItsBaselines) {
   const std::string naive = "render,naive,warp=naive K=1 hole-sources=0 fill=inpaint";
   EXPECT_GT(Cell(csv, ours, "psnr"), Cell(csv, naive, "psnr") + 5);
   EXPECT_LT(Cell(csv, ours, "time"), Cell(csv, naive, "time"));
-  // More sources where holes remain close some of them (or none are added: no holes).
-  EXPECT_LE(Cell(csv, "render,parallax,warp=mesh K=4 hole-sources=2 fill=depth-aware", "hole_ratio"),
-            Cell(csv, ours, "hole_ratio"));
+  // More sources where holes remain close some of them; under 0.1% of holes none are tried.
+  const double holes_k4 = Cell(csv, ours, "hole_ratio");
+  const double holes_more =
+      Cell(csv, "render,parallax,warp=mesh K=4 hole-sources=2 fill=depth-aware", "hole_ratio");
+  if (holes_k4 >= 0.001) {
+    EXPECT_LT(holes_more, holes_k4);
+  } else {
+    EXPECT_EQ(holes_more, holes_k4);
+  }
   // Depth at half resolution: cheaper and less accurate (measured 0.73 vs 0.82 within 2%).
   EXPECT_LT(Cell(csv, "depth,patchmatch,quality=balanced sources=5 scale=0.5", "within_2pct"),
             Cell(csv, "depth,patchmatch,quality=balanced sources=5,", "within_2pct"));

@@ -115,13 +115,13 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
   ASSERT_GT(result.metrics.out_of_view_ratio, 0.15);
   double worst = 0, worst_edge_colour = 0;
   int checked = 0;
+  // The top row of sky the source saw: what copying the edge of the sampled sky would give.
+  const Eigen::Vector3f edge = scene.sky(test::PixelRay(source.Posed(), 80, 0).normalized());
   for (int y = 0; y < 120; ++y) {
     for (int x = 0; x < 160; ++x) {
       if (result.classes.At(x, y) != PixelClass::kOutOfView) continue;
       ++checked;
       const Eigen::Vector3f truth = scene.sky(test::PixelRay(target, x, y).normalized());
-      // What the top row of sampled sky (the edge the old neighbour average copied) has.
-      const Eigen::Vector3f edge = scene.sky(test::PixelRay(source.Posed(), 80, 0).normalized());
       for (int ch = 0; ch < 3; ++ch) {
         worst = std::max(worst, static_cast<double>(std::abs(result.color.At(x, y, ch) - truth(ch))));
         worst_edge_colour = std::max(worst_edge_colour, static_cast<double>(std::abs(edge(ch) - truth(ch))));
