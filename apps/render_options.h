@@ -21,6 +21,9 @@ struct NovelViewSettings {
   // --depth-holes: "mesh" fills the pixels a workspace's depth maps have no depth for from
   // its mesh (when reconstruct made one), "none" leaves them holes.
   std::string depth_holes = "mesh";
+  // --edge-erosion: a workspace's depth pixels this close to a farther neighbour, on the near
+  // side, are dropped (ErodeDepthEdges); 0 keeps them.
+  int edge_erosion_px = 2;
   // Applies `warp` to `render`; call before using the settings.
   void Resolve();
 };
@@ -37,7 +40,9 @@ struct WorkspaceDepthPreparation {
 // which would float in the sky and be smeared into streaks by the fill), then, with
 // depth_holes "mesh" and <workspace>/mesh/mesh.obj present, the depth-0 pixels the mesh covers
 // take its depth (Embree, one ray per pixel): estimated depth maps lack depth where matching
-// failed (~12% of the courtyard's photos).
+// failed (~12% of the courtyard's photos); last, edge_erosion_px pixels of the near side of
+// every depth edge are dropped (ErodeDepthEdges): window-based stereo fattens occluders, and
+// their edge pixels mix in the background's colour. Ground-truth depth is used as it is.
 WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& workspace,
                                                 const NovelViewSettings& settings,
                                                 SourceLibrary* library);

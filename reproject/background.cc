@@ -131,4 +131,61 @@ int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step) {
   return cleared;
 }
 
+int ErodeDepthEdges(DepthMap* depth, float max_step, int pixels) {
+  if (!(max_step > 0) || pixels < 0) {
+    throw std::invalid_argument("ErodeDepthEdges: max_step " + std::to_string(max_step) +
+                                ", pixels " + std::to_string(pixels) + ": expected > 0 and >= 0");
+  }
+  const int width = depth->Width(), height = depth->Height();
+  std::vector<float>& values = depth->Values();
+  const size_t count = values.size();
+  const auto index = [&](int x, int y) {
+    return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
+  };
+  // Ring by ring: first the near-side edge pixels, then their neighbours on the same surface.
+  std::vector<size_t> ring, next;
+  std::vector<uint8_t> cleared(count, 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const float d = values[index(x, y)];
+      if (d == 0) continue;
+      const auto farther = [&](int nx, int ny) {
+        if (nx < 0 || ny < 0 || nx >= width || ny >= height) return false;
+        const float n = values[index(nx, ny)];
+        return n != 0 && n > d * (1 + max_step);
+      };
+      if (farther(x - 1, y) || farther(x + 1, y) || farther(x, y - 1) || farther(x, y + 1)) {
+        ring.push_back(index(x, y));
+        cleared[index(x, y)] = 1;
+      }
+    }
+  }
+  int total = 0;
+  for (int step = 0; step < pixels && !ring.empty(); ++step) {
+    next.clear();
+    for (size_t i : ring) {
+      const int x = static_cast<int>(i % static_cast<size_t>(width));
+      const int y = static_cast<int>(i / static_cast<size_t>(width));
+      const auto spread = [&](int nx, int ny) {
+        if (nx < 0 || ny < 0 || nx >= width || ny >= height) return;
+        const size_t j = index(nx, ny);
+        const float lo = std::min(values[i], values[j]), hi = std::max(values[i], values[j]);
+        if (cleared[j] != 0 || values[j] == 0 || !(hi <= lo * (1 + max_step))) return;
+        cleared[j] = 1;
+        next.push_back(j);
+      };
+      if (step + 1 < pixels) {
+        spread(x - 1, y);
+        spread(x + 1, y);
+        spread(x, y - 1);
+        spread(x, y + 1);
+      }
+    }
+    for (size_t i : ring) values[i] = 0;
+    total += static_cast<int>(ring.size());
+    ring.swap(next);
+  }
+  return total;
+}
+
 }  // namespace parallax

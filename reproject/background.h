@@ -33,4 +33,13 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
 // max_step <= 0.
 int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step);
 
+// Sets to 0 the pixels of `depth` on the near side of a depth edge: within `pixels` (4-steps)
+// of a 4-neighbour more than max_step relative depth farther away, along the near surface.
+// A photo mixes the two surfaces' colours in its edge pixels, and estimated depth puts them on
+// the near surface (foreground fattening): warped, they draw a halo of the background colour
+// around every occluder. Without them the near surface stops a pixel short and the other
+// sources (or the fill) give the background there. Returns how many values were cleared.
+// Throws std::invalid_argument for max_step <= 0 or pixels < 0.
+int ErodeDepthEdges(DepthMap* depth, float max_step, int pixels);
+
 }  // namespace parallax

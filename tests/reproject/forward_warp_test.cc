@@ -157,6 +157,36 @@ TEST(RemoveDepthSpeckles, ClearsSmallPatchesOnly) {
   EXPECT_THROW(RemoveDepthSpeckles(&strict, 10, 0), std::invalid_argument);
 }
 
+// A box (depth 4) in front of a wall (depth 8), on a 20x10 map: two pixels of the box along
+// its edge go, the wall and the box's inside stay; a gentle slope is no edge.
+TEST(ErodeDepthEdges, ClearsTheNearSideOfEdgesOnly) {
+  DepthMap depth(20, 10);
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 20; ++x) depth.At(x, y) = x >= 5 && x < 15 ? 4.0f : 8.0f;
+  }
+  DepthMap eroded = depth;
+  EXPECT_EQ(ErodeDepthEdges(&eroded, 0.05f, 2), 2 * 2 * 10);
+  for (int y = 0; y < 10; ++y) {
+    EXPECT_EQ(eroded.At(4, y), 8) << "the wall stays";
+    EXPECT_EQ(eroded.At(5, y), 0);
+    EXPECT_EQ(eroded.At(6, y), 0);
+    EXPECT_EQ(eroded.At(7, y), 4) << "the third pixel in stays";
+    EXPECT_EQ(eroded.At(14, y), 0);
+    EXPECT_EQ(eroded.At(13, y), 0);
+    EXPECT_EQ(eroded.At(12, y), 4);
+    EXPECT_EQ(eroded.At(15, y), 8);
+  }
+  DepthMap untouched = depth;
+  EXPECT_EQ(ErodeDepthEdges(&untouched, 0.05f, 0), 0);
+  EXPECT_EQ(untouched.Values(), depth.Values());
+  DepthMap slope(20, 10);
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 20; ++x) slope.At(x, y) = 5.0f * std::pow(1.03f, static_cast<float>(x));
+  }
+  EXPECT_EQ(ErodeDepthEdges(&slope, 0.05f, 2), 0);
+  EXPECT_THROW(ErodeDepthEdges(&slope, 0, 2), std::invalid_argument);
+}
+
 // Sky colour encodes the world direction, so a warped sky pixel tells where it came from.
 Eigen::Vector3f SkyColor(const Eigen::Vector3d& dir) {
   return Eigen::Vector3f(static_cast<float>(0.5 + 0.4 * dir.x() / dir.z()),
