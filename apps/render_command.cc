@@ -111,7 +111,8 @@ void RegisterRenderCommand(CLI::App& app) {
             : CamerasFromModel(arguments->cameras);
     const size_t all_views = library.Cameras().size();
     nlohmann::json stages = nlohmann::json::array();
-    if (std::filesystem::is_directory(arguments->input / "gt")) {
+    const bool scene_folder = std::filesystem::is_directory(arguments->input / "gt");
+    if (scene_folder) {
       stages.push_back(Stage("depth", "a scene folder: its ground-truth depth maps are used"));
     } else {
       const std::vector<std::string> estimated = EstimateMissingDepth(arguments->input, library, targets, selection);
@@ -130,7 +131,6 @@ void RegisterRenderCommand(CLI::App& app) {
       std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
                    name.c_str());
     }
-    const bool scene_folder = std::filesystem::is_directory(arguments->input / "gt");
     const WorkspaceDepthPreparation depth_holes =
         scene_folder ? WorkspaceDepthPreparation{}
                      : PrepareWorkspaceDepth(arguments->input, arguments->settings, &library);

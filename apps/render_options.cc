@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "pipeline/raycaster.h"
-#include "reproject/background.h"
 #include "pipeline/textured_mesh.h"
+#include "reproject/background.h"
 
 namespace parallax {
 

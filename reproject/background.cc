@@ -19,6 +19,11 @@ bool SimilarColor(const float* a, const float* b, float max_step) {
   return true;
 }
 
+// Two depth values of one surface: the larger within max_step of the smaller, relatively.
+bool SameSurface(float a, float b, float max_step) {
+  return std::max(a, b) <= std::min(a, b) * (1 + max_step);
+}
+
 }  // namespace
 
 std::vector<uint8_t> MarkBackground(const DepthMap& depth, const Image& color, float max_step) {
@@ -113,9 +118,7 @@ int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step) {
       const int x = static_cast<int>(i % static_cast<size_t>(width));
       const int y = static_cast<int>(i / static_cast<size_t>(width));
       const auto visit = [&](size_t j) {
-        if (visited[j] != 0 || values[j] == 0) return;
-        const float lo = std::min(values[i], values[j]), hi = std::max(values[i], values[j]);
-        if (!(hi <= lo * (1 + max_step))) return;
+        if (visited[j] != 0 || values[j] == 0 || !SameSurface(values[i], values[j], max_step)) return;
         visited[j] = 1;
         patch.push_back(j);
       };
@@ -169,8 +172,7 @@ int ErodeDepthEdges(DepthMap* depth, float max_step, int pixels) {
       const auto spread = [&](int nx, int ny) {
         if (nx < 0 || ny < 0 || nx >= width || ny >= height) return;
         const size_t j = index(nx, ny);
-        const float lo = std::min(values[i], values[j]), hi = std::max(values[i], values[j]);
-        if (cleared[j] != 0 || values[j] == 0 || !(hi <= lo * (1 + max_step))) return;
+        if (cleared[j] != 0 || values[j] == 0 || !SameSurface(values[i], values[j], max_step)) return;
         cleared[j] = 1;
         next.push_back(j);
       };

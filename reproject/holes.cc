@@ -273,8 +273,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
         map.classes[i] = PixelClass::kBackground;
         continue;
       }
-      const Eigen::Vector3d ray((x + 0.5 - pinhole.cx) / pinhole.fx,
-                                (y + 0.5 - pinhole.cy) / pinhole.fy, 1.0);
+      const Eigen::Vector3d ray = pinhole.PixelRay(x, y);
       // The span of depths some source's frustum holds (inverse depths, nearest first).
       double inv_near = 0, inv_far = kInf;
       bool in_view = false;

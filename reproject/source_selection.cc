@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -47,6 +48,24 @@ double EstimateSceneDepth(const std::vector<PosedCamera>& sources, const PosedCa
   return distances.empty() ? 1.0 : Median(distances);
 }
 
+// The angle (degrees) at point `p` between the rays to it from a source's centre and from
+// `target_center`, both in that source's camera frame (its centre at the origin); nullopt when
+// `p` is not in front of the source and inside its frame.
+std::optional<double> SeenAngleDeg(const Pinhole& source, const Eigen::Vector3d& p,
+                                   const Eigen::Vector3d& target_center) {
+  if (!(p.z() > 1e-9 * p.norm())) return std::nullopt;
+  const double u = source.fx * p.x() / p.z() + source.cx, v = source.fy * p.y() / p.z() + source.cy;
+  if (!(u >= 0 && v >= 0 && u <= source.width && v <= source.height)) return std::nullopt;
+  const double cos_angle = p.normalized().dot((p - target_center).normalized());
+  return std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+}
+
+// How well a source sees a point from `angle_deg` off the target's ray: 1 / (1 + angle /
+// angle_scale_deg).
+double ViewQuality(double angle_deg, const SourceSelectionOptions& options) {
+  return 1 / (1 + angle_deg / options.angle_scale_deg);
+}
+
 // What one source sees of the target's sample points.
 struct SampleViews {
   std::vector<uint8_t> seen;             // Per sample.
@@ -78,17 +97,12 @@ SourceScore ScoreOne(const PosedCamera& source, const PosedCamera& target, doubl
                                         (v - t.cy) / t.fy * scene_depth * factor,
                                         scene_depth * factor);
         const Eigen::Vector3d p = source_from_target * in_target;
-        if (!(p.z() > 1e-9 * p.norm())) continue;
-        const double su = s.fx * p.x() / p.z() + s.cx, sv = s.fy * p.y() / p.z() + s.cy;
-        if (!(su >= 0 && sv >= 0 && su <= s.width && sv <= s.height)) continue;
+        const std::optional<double> angle = SeenAngleDeg(s, p, target_center_in_source);
+        if (!angle) continue;
         ++seen;
-        // Rays to the point from the source centre (origin here) and the target centre.
-        const Eigen::Vector3d from_target = p - target_center_in_source;
-        const double cos_angle = p.normalized().dot(from_target.normalized());
-        const double angle_deg = std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
-        angle_sum += angle_deg;
+        angle_sum += *angle;
         views->seen.back() = 1;
-        views->quality.back() = static_cast<float>(1 / (1 + angle_deg / options.angle_scale_deg));
+        views->quality.back() = static_cast<float>(ViewQuality(*angle, options));
         // In the target frame, so that directions of different sources compare.
         views->to_source.back() = (target_from_source_rotation * -p.normalized()).cast<float>();
       }
@@ -198,18 +212,15 @@ int SourceSeeingMost(const std::vector<PosedCamera>& sources, const PosedCamera&
     if (std::find(exclude.begin(), exclude.end(), static_cast<int>(i)) != exclude.end()) continue;
     const Pinhole s = Pinhole::From(sources[i].camera);
     const Rigid3d& cam_from_world = sources[i].cam_from_world;
-    const Eigen::Vector3d center = CameraCenter(cam_from_world);
+    const Eigen::Vector3d target_center_in_source = cam_from_world * target_center;
     int inside = 0;
     double score = 0;
     for (const Eigen::Vector3d& point : points) {
-      const Eigen::Vector3d p = cam_from_world * point;
-      if (!(p.z() > 1e-9 * p.norm())) continue;
-      const double u = s.fx * p.x() / p.z() + s.cx, v = s.fy * p.y() / p.z() + s.cy;
-      if (!(u >= 0 && v >= 0 && u <= s.width && v <= s.height)) continue;
+      const std::optional<double> angle_deg =
+          SeenAngleDeg(s, cam_from_world * point, target_center_in_source);
+      if (!angle_deg) continue;
       ++inside;
-      const double cos_angle = (center - point).normalized().dot((target_center - point).normalized());
-      const double angle_deg = std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
-      score += 1 / (1 + angle_deg / options.angle_scale_deg);
+      score += ViewQuality(*angle_deg, options);
     }
     if (inside >= min_points && score > best_score) {
       best_score = score;
