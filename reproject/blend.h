@@ -11,8 +11,13 @@ namespace parallax {
 
 struct BlendOptions {
   // Samples within this relative depth of the front-most one at a pixel are one surface and
-  // are blended; farther ones are occluded. In (0, 1).
-  double depth_tolerance = 0.01;
+  // are blended; farther ones are occluded. In (0, 1). 5%, as ErodeDepthEdges separates
+  // occluders from their background: 1% split one surface into front and behind wherever the
+  // sources' depths disagree by a little (estimated depth, sampling), and one source's sample
+  // stood alone. Courtyard novel views 1% -> 5%: estimated 27.89 -> 28.10 dB, ground-truth
+  // sources 31.87 -> 31.92; on the small scene 23.39 -> 23.59 and 30.63 -> 30.88 (10%: within
+  // 0.05 dB of 5%).
+  double depth_tolerance = 0.05;
   // Added to the ray angle in the weight 1 / ((angle + epsilon) * max(1, stretch)), so a
   // source that sees the point exactly along the target ray gets a large, finite weight
   // (radians, > 0).

@@ -21,8 +21,11 @@ struct FillOptions {
   // kDepthAware: directions scanned from each pixel to the nearest sampled one; 8 or 16.
   int directions = 16;
   // kDepthAware: candidates within this relative depth of the farthest one are the
-  // background side and are averaged; in (0, 1).
-  double background_tolerance = 0.1;
+  // background side and are averaged; in (0, 1). 20% averages the background of a
+  // disocclusion over more of its rim (a slanted floor's depth varies along it): courtyard
+  // novel views 10% -> 20%: estimated 28.10 -> 28.17 dB, ground-truth sources 31.92 -> 31.99
+  // (5%: 27.88 / 31.61; 30-99%: within 0.08 dB of 20%).
+  double background_tolerance = 0.2;
   // kInpaint: Telea neighbourhood radius in pixels, > 0.
   double inpaint_radius_px = 3;
 
