@@ -39,7 +39,8 @@ struct Vertices {
 
 struct WarpScratch::Data {
   Vertices vertices;
-  std::vector<uint8_t> background;  // MarkBackground.
+  std::vector<uint8_t> background;  // MarkBackground, when the source has none to share.
+  const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
   std::vector<uint8_t> edge;        // Mesh: vertices to splat.
   std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
@@ -422,7 +423,17 @@ WarpScratch::WarpScratch() : data_(std::make_unique<Data>()) {}
 WarpScratch::~WarpScratch() = default;
 WarpScratch::WarpScratch(WarpScratch&&) noexcept = default;
 WarpScratch& WarpScratch::operator=(WarpScratch&&) noexcept = default;
-const std::vector<uint8_t>& WarpScratch::Background() const { return data_->background; }
+const std::vector<uint8_t>& WarpScratch::Background() const {
+  static const std::vector<uint8_t> kNone;
+  return data_->background_used != nullptr ? *data_->background_used : kNone;
+}
+
+void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options) {
+  options.Check();
+  const auto step = static_cast<float>(options.background_max_step);
+  source->background = MarkBackground(source->depth, source->color, step);
+  source->background_step = step;
+}
 
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
                  const ForwardWarpOptions& options, WarpBuffer* buffer, WarpScratch* scratch) {
@@ -435,11 +446,15 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
 
   const int width = setup.src.width, height = setup.src.height;
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
+  data.background_used = nullptr;
   if (options.background_at_infinity) {
-    MarkBackground(source.depth, source.color, static_cast<float>(options.background_max_step),
-                   &data.background, &data.stack);
-  } else {
-    data.background.clear();
+    const auto step = static_cast<float>(options.background_max_step);
+    if (source.background.size() == count && source.background_step == step) {
+      data.background_used = &source.background;
+    } else {
+      MarkBackground(source.depth, source.color, step, &data.background, &data.stack);
+      data.background_used = &data.background;
+    }
   }
   data.ray_x.resize(static_cast<size_t>(width));
   for (int x = 0; x < width; ++x) {
@@ -457,7 +472,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
   }
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      ProjectRow(setup, source, data.background.empty() ? nullptr : data.background.data(),
+      ProjectRow(setup, source, data.background_used != nullptr ? data.background_used->data() : nullptr,
                  data.ray_x.data(), y, &vertices);
     }
   });

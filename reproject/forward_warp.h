@@ -100,13 +100,17 @@ class WarpScratch {
 
   struct Data;  // Defined in forward_warp.cc.
   Data& Get() { return *data_; }
-  // MarkBackground of the last warped source's depth and colour; empty when it did not use
-  // background at infinity.
+  // MarkBackground of the last warped source's depth and colour (its own or the source's);
+  // empty when it did not use background at infinity.
   const std::vector<uint8_t>& Background() const;
 
  private:
   std::unique_ptr<Data> data_;
 };
+
+// Marks source->background (MarkBackground of its depth and colour, with the options'
+// background_max_step) for the warps to share; call again whenever the depth changes.
+void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options = {});
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see

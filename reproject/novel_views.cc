@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+#include "reproject/forward_warp.h"
 #include "reproject/scene_views.h"
 
 namespace parallax {
@@ -180,6 +181,7 @@ const SourceView& SourceLibrary::Load(int index) {
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     CheckSourceView(*view);
+    MarkSourceBackground(view.get());
     slot = std::move(view);
   }
   return *slot;

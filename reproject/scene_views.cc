@@ -3,6 +3,7 @@
 #include "core/depth_map.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+#include "reproject/forward_warp.h"
 
 namespace parallax {
 namespace {
@@ -47,6 +48,7 @@ std::vector<SourceView> ReadSourceViews(const ViewSetPaths& paths) {
     view.color = LinearRgb(ReadImage(paths.images / names[i]));
     view.depth = ReadDepthExr(paths.DepthFor(names[i]));
     CheckSourceView(view);
+    MarkSourceBackground(&view);
     views.push_back(std::move(view));
   }
   return views;

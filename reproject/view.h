@@ -9,7 +9,9 @@
 //    std::invalid_argument.
 //  - Colours are linear-light float RGB in memory; callers convert sRGB with core/image.h.
 //  - No NaN or Inf ever leaves a function: divisions are guarded and results checked finite.
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/camera.h"
 #include "core/depth_map.h"
@@ -32,6 +34,12 @@ struct SourceView {
   Rigid3d cam_from_world;
   Image color;     // Linear RGB, 3 channels, camera size.
   DepthMap depth;  // z-depth in scene units, 0 = no value; camera size.
+  // Which depth-0 pixels are background at infinity: MarkBackground of depth and colour with
+  // background_step (see MarkSourceBackground in forward_warp.h). It depends on the source
+  // alone, so loaders mark it once, after the depth is final, instead of every warp doing it
+  // again; when empty or made with another step, ForwardWarp marks its own.
+  std::vector<uint8_t> background;
+  float background_step = 0;
 
   PosedCamera Posed() const { return {camera, cam_from_world}; }
 };

@@ -1,7 +1,10 @@
 #include "reproject/forward_warp.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -239,6 +242,38 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
   EXPECT_EQ(result.metrics.disocclusion_ratio, 0);
   // Background never reaches the depth map.
   for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z));
+}
+
+// A source's own background mask (MarkSourceBackground) warps exactly as the mask the warp
+// marks itself; a mask made with another colour step is not used.
+TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
+  const Camera camera = TestCamera(160, 120, 150);
+  Scene scene;
+  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
+  scene.sky = SkyColor;
+  SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  const PosedCamera target = CameraAt(camera, {0.3, -0.1, 0.2});
+  const auto warp = [&](const SourceView& view) {
+    WarpBuffer buffer;
+    WarpScratch scratch;
+    ForwardWarp(view, target, {}, &buffer, &scratch);
+    return std::make_pair(std::vector<float>(buffer.Depths(), buffer.Depths() + buffer.Size()),
+                          scratch.Background());
+  };
+  const auto [own_depth, own_mask] = warp(source);
+  ASSERT_GT(std::count(own_mask.begin(), own_mask.end(), 1), 160 * 120 / 2);
+
+  MarkSourceBackground(&source);
+  EXPECT_EQ(source.background, own_mask);
+  const auto [shared_depth, shared_mask] = warp(source);
+  EXPECT_EQ(shared_depth, own_depth);
+
+  // A stale mask (everything background) made with another step: the warp marks its own.
+  std::fill(source.background.begin(), source.background.end(), uint8_t{1});
+  source.background_step = 0.5f;
+  const auto [restep_depth, restep_mask] = warp(source);
+  EXPECT_EQ(restep_mask, own_mask);
+  EXPECT_EQ(restep_depth, own_depth);
 }
 
 TEST(ForwardWarp, EnclosedDepthZeroIsAHoleNotBackground) {
