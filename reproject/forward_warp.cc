@@ -42,7 +42,8 @@ struct WarpScratch::Data {
   std::vector<uint8_t> background;  // MarkBackground, when the source has none to share.
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
-  std::vector<uint8_t> edge;        // Mesh: vertices to splat.
+  std::vector<uint8_t> edge;        // Mesh: per vertex, 1 when it is to be splatted.
+  std::vector<size_t> edge_list;    // Mesh: the vertices to splat.
   std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
 };
@@ -208,20 +209,30 @@ class SourceWarper {
   // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
   // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
   // source's stride.
-  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch) {
+  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch,
+            std::vector<size_t>* edge_list_scratch) {
     const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
     continuous_ = continuous.data();
     edge_ = edge_scratch;
+    edge_list_ = edge_list_scratch;
     edge_->assign(count, 0);
+    edge_list_->clear();
     for (int y = 0; y + 1 < height_; y += kMaxBlock) {
       for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
     }
-    for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        const bool border = x == 0 || y == 0 || x + 1 == width_ || y + 1 == height_;
-        if (border || (*edge_)[Index(x, y)] != 0) SplatVertex(x, y);
-      }
+    for (int x = 0; x < width_; ++x) {
+      MarkEdge(Index(x, 0));
+      MarkEdge(Index(x, height_ - 1));
     }
+    for (int y = 0; y < height_; ++y) {
+      MarkEdge(Index(0, y));
+      MarkEdge(Index(width_ - 1, y));
+    }
+    // In row-major order, as a scan of every vertex would splat them (z-test ties go the same
+    // way), without scanning every vertex.
+    std::sort(edge_list_->begin(), edge_list_->end());
+    const size_t w = static_cast<size_t>(width_);
+    for (size_t i : *edge_list_) SplatVertex(static_cast<int>(i % w), static_cast<int>(i / w));
   }
 
   void Splats() {
@@ -236,11 +247,25 @@ class SourceWarper {
   }
   float SourceDepth(size_t i) const { return source_.depth.Values()[i]; }
 
-  Corner CornerAt(size_t i) const {
-    const size_t w = static_cast<size_t>(width_);
-    return {vtx_.u[i], vtx_.v[i], vtx_.inv_z[i], vtx_.angle[i],
-            source_.color.Pixels().data() + 3 * i, static_cast<float>(i % w),
-            static_cast<float>(i / w)};
+  // A source pixel centre by index and coordinates, kept together: deriving the coordinates
+  // from the index would cost two 64-bit divisions per corner.
+  struct Sample {
+    size_t i;
+    int x, y;
+  };
+  Sample At(int x, int y) const { return {Index(x, y), x, y}; }
+
+  Corner CornerAt(const Sample& p) const {
+    return {vtx_.u[p.i], vtx_.v[p.i], vtx_.inv_z[p.i], vtx_.angle[p.i],
+            source_.color.Pixels().data() + 3 * p.i, static_cast<float>(p.x),
+            static_cast<float>(p.y)};
+  }
+
+  // Queues a vertex for splatting, once.
+  void MarkEdge(size_t i) {
+    if ((*edge_)[i] != 0) return;
+    (*edge_)[i] = 1;
+    edge_list_->push_back(i);
   }
 
   static constexpr int kMaxBlock = 4;
@@ -287,8 +312,8 @@ class SourceWarper {
     if (x + 1 >= width_ || y + 1 >= height_) return;
     const uint8_t kind = BlockKind(x, y, side);
     if (kind != kInvalid) {
-      const Corner a = CornerAt(Index(x, y)), b = CornerAt(Index(x + side, y));
-      const Corner c = CornerAt(Index(x, y + side)), d = CornerAt(Index(x + side, y + side));
+      const Corner a = CornerAt(At(x, y)), b = CornerAt(At(x + side, y));
+      const Corner c = CornerAt(At(x, y + side)), d = CornerAt(At(x + side, y + side));
       if (kind == kSurface) {
         raster_->SurfaceBlock(a, b, c, d, static_cast<float>(side));
       } else {
@@ -304,10 +329,9 @@ class SourceWarper {
       Block(x + half, y + half, half);
       return;
     }
-    const size_t i00 = Index(x, y), i10 = i00 + 1;
-    const size_t i01 = i00 + static_cast<size_t>(width_), i11 = i01 + 1;
-    Triangle(i00, i10, i01, edge_);
-    Triangle(i10, i11, i01, edge_);
+    const Sample p00 = At(x, y), p10 = At(x + 1, y), p01 = At(x, y + 1), p11 = At(x + 1, y + 1);
+    Triangle(p00, p10, p01);
+    Triangle(p10, p11, p01);
   }
 
   // Two samples of one surface (or both background).
@@ -318,21 +342,23 @@ class SourceWarper {
     return std::max(a, b) <= s_.max_depth_ratio * std::min(a, b);
   }
 
-  void Triangle(size_t a, size_t b, size_t c, std::vector<uint8_t>* edge) {
-    const uint8_t ka = vtx_.kind[a], kb = vtx_.kind[b], kc = vtx_.kind[c];
+  void Triangle(const Sample& a, const Sample& b, const Sample& c) {
+    const uint8_t ka = vtx_.kind[a.i], kb = vtx_.kind[b.i], kc = vtx_.kind[c.i];
     if (ka == kInvalid && kb == kInvalid && kc == kInvalid) return;
     if (ka == kb && kb == kc) {
       if (ka == kSky) {
         raster_->BackgroundTriangle(CornerAt(a), CornerAt(b), CornerAt(c));
         return;
       }
-      const float da = SourceDepth(a), db = SourceDepth(b), dc = SourceDepth(c);
+      const float da = SourceDepth(a.i), db = SourceDepth(b.i), dc = SourceDepth(c.i);
       if (std::max({da, db, dc}) <= s_.max_depth_ratio * std::min({da, db, dc})) {
         raster_->SurfaceTriangle(CornerAt(a), CornerAt(b), CornerAt(c));
         return;
       }
     }
-    (*edge)[a] = (*edge)[b] = (*edge)[c] = 1;
+    MarkEdge(a.i);
+    MarkEdge(b.i);
+    MarkEdge(c.i);
   }
 
   // Local magnification from the neighbour in `step` direction (or the opposite one), as the
@@ -367,7 +393,7 @@ class SourceWarper {
     const float extent_v = std::clamp(overlap * (std::abs(du[1]) + std::abs(dv[1])), 1.0f, max_px);
     float stretch = std::abs(du[0] * dv[1] - du[1] * dv[0]);
     if (!Finite(stretch)) stretch = max_px * max_px;
-    raster_->Splat(CornerAt(i), 0.5f * extent_u, 0.5f * extent_v, stretch, background);
+    raster_->Splat(CornerAt({i, x, y}), 0.5f * extent_u, 0.5f * extent_v, stretch, background);
   }
 
   const SourceView& source_;
@@ -379,6 +405,7 @@ class SourceWarper {
   int height_;
   const uint8_t* continuous_ = nullptr;
   std::vector<uint8_t>* edge_ = nullptr;
+  std::vector<size_t>* edge_list_ = nullptr;
 };
 
 template <typename T>
@@ -488,7 +515,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
         ContinuousRow(source, setup, vertices, y, data.continuous.data());
       }
     });
-    warper.Mesh(data.continuous, &data.edge);
+    warper.Mesh(data.continuous, &data.edge, &data.edge_list);
   } else {
     warper.Splats();
   }
