@@ -12,27 +12,31 @@ namespace parallax {
 namespace {
 
 // One row of the blend, buffer after buffer (each buffer's row is read as a stream).
-// `scratch` is resized to 7 floats per pixel of the row.
+// `scratch` is resized to 8 floats per pixel of the row.
 void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance,
               float angle_epsilon, int min_support, std::vector<float>* scratch,
               BlendResult* out) {
   const size_t width = static_cast<size_t>(out->color.Width());
   const size_t row = static_cast<size_t>(y) * width;
-  scratch->assign(7 * width, 0.0f);
+  scratch->resize(8 * width);
   float* front = scratch->data();             // Front-most surface depth; +inf: none.
   float* rgb_sum = front + width;             // Interleaved.
   float* depth_sum = rgb_sum + 3 * width;
   float* weight = depth_sum + width;
   float* any_background = weight + width;     // 1 where a background sample landed.
   std::fill(front, front + width, WarpBuffer::kBackground);
+  std::fill(rgb_sum, any_background + width, 0.0f);
   float* back = depth_sum;  // Farthest surface depth; 0: none (depth_sum is zeroed below).
+  // Without branches (depth 0 maps to +inf for the front, background to 0 for the back), so
+  // that it vectorises.
   for (const WarpBuffer& buffer : buffers) {
-    const float* depth = buffer.Depths() + row;
+    const float* __restrict depth = buffer.Depths() + row;
     for (size_t x = 0; x < width; ++x) {
       const float d = depth[x];
-      if (d == WarpBuffer::kBackground) any_background[x] = 1.0f;
-      if (d > 0 && d < front[x]) front[x] = d;
-      if (d != WarpBuffer::kBackground && d > back[x]) back[x] = d;
+      const bool background = d == WarpBuffer::kBackground;
+      any_background[x] = background ? 1.0f : any_background[x];
+      front[x] = std::min(front[x], d > 0 ? d : WarpBuffer::kBackground);
+      back[x] = std::max(back[x], background ? 0.0f : d);
     }
   }
   if (min_support > 1 && buffers.size() > 1) {
@@ -62,14 +66,16 @@ void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance,
     }
   }
   std::fill(depth_sum, depth_sum + width, 0.0f);
+  // Where a surface landed, the samples up to this depth; elsewhere +inf takes the
+  // background samples (nothing else landed there).
+  float* limit = any_background + width;
+  for (size_t x = 0; x < width; ++x) limit[x] = front[x] * (1.0f + tolerance);
   for (const WarpBuffer& buffer : buffers) {
     const float* depth = buffer.Depths() + row;
     for (size_t x = 0; x < width; ++x) {
       const float d = depth[x];
-      if (d == 0) continue;
+      if (!(d > 0 && d <= limit[x])) continue;
       const bool surface = front[x] != WarpBuffer::kBackground;
-      const bool take = surface ? d <= front[x] * (1.0f + tolerance) : d == WarpBuffer::kBackground;
-      if (!take) continue;
       const WarpWeight& ww = buffer.Weight(row + x);
       const float w =
           1.0f / ((ww.ray_angle_rad + angle_epsilon) * std::max(1.0f, ww.stretch));
