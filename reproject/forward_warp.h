@@ -100,8 +100,9 @@ class WarpScratch {
 
   struct Data;  // Defined in forward_warp.cc.
   Data& Get() { return *data_; }
-  // MarkBackground of the last warped source's depth and colour (its own or the source's);
-  // empty when it did not use background at infinity.
+  // MarkBackground of the last warped source's depth and colour (the warp's own, or the
+  // source's own mask, which lives as long as the source); empty when the warp did not use
+  // background at infinity.
   const std::vector<uint8_t>& Background() const;
 
  private:
