@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/scene_folder.h"
+#include "reproject/forward_warp.h"
 #include "reproject/render.h"
 #include "reproject/scene_views.h"
 #include "reproject/source_selection.h"
@@ -75,6 +76,7 @@ SourceView Upsampled(const SourceView& view, int scale, int height) {
               : view.depth.At(x / scale, (y + crop) / scale);
     }
   }
+  MarkSourceBackground(&out);  // The copied mask was the small view's.
   return out;
 }
 
