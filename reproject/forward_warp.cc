@@ -315,9 +315,9 @@ class SourceWarper {
       const Corner a = CornerAt(At(x, y)), b = CornerAt(At(x + side, y));
       const Corner c = CornerAt(At(x, y + side)), d = CornerAt(At(x + side, y + side));
       if (kind == kSurface) {
-        raster_->SurfaceBlock(a, b, c, d, static_cast<float>(side));
+        raster_->TexturedBlock<false>(a, b, c, d, static_cast<float>(side));
       } else {
-        raster_->TexturedQuad<true>(a, b, c, d, static_cast<float>(side));
+        raster_->TexturedBlock<true>(a, b, c, d, static_cast<float>(side));
       }
       return;
     }

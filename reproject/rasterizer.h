@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <utility>
 
@@ -66,21 +67,6 @@ struct TriangleSetup {
     }
     return true;
   }
-
-  // Barycentric weights of the pixel centre; false outside. Edges are inclusive with a hair
-  // of slack, so no centre on a shared edge falls between two triangles.
-  bool Inside(float pu, float pv, float w[3]) const {
-    constexpr float kSlack = -1e-5f;
-    const float du = pu - origin_u, dv = pv - origin_v;
-    w[0] = 1.0f + w0_du * du + w0_dv * dv;
-    w[1] = w1_du * du + w1_dv * dv;
-    w[2] = 1.0f - w[0] - w[1];
-    return w[0] >= kSlack && w[1] >= kSlack && w[2] >= kSlack;
-  }
-
-  static float Attribute(const float values[3], const float w[3]) {
-    return w[0] * values[0] + w[1] * values[1] + w[2] * values[2];
-  }
 };
 
 // An attribute affine in the image: value + du * d_u + dv * d_v, with du, dv relative to an
@@ -113,6 +99,52 @@ struct AttributePlanes {
   }
 };
 
+// Four pixels of a row side by side, in GCC / Clang vector extensions (SSE on x86-64, NEON on
+// ARM, plain code elsewhere). Comparisons give -1 (true) or 0 per lane.
+using F4 = float __attribute__((vector_size(16)));
+using I4 = int32_t __attribute__((vector_size(16)));
+
+// A triangle's attributes at four pixels: depth, source position relative to the block's
+// first corner, ray angle; `front`: in front of the camera (always, for background).
+struct Lanes {
+  F4 z, fx, fy, angle;
+  I4 front;
+};
+
+// AttributePlanes along one pixel row: value at du = 0 and slope in u.
+struct RowPlanes {
+  float inv_z, sx, sy, angle;
+  float d_inv_z, d_sx, d_sy, d_angle;
+
+  RowPlanes(const AttributePlanes& p, float dv)
+      : inv_z(p.inv_z.At(0, dv)), sx(p.sx.At(0, dv)), sy(p.sy.At(0, dv)),
+        angle(p.angle.At(0, dv)), d_inv_z(p.inv_z.d_u), d_sx(p.sx.d_u), d_sy(p.sy.d_u),
+        d_angle(p.angle.d_u) {}
+
+  // Background planes are the attributes themselves (screen-affine); surface planes are
+  // attributes / z.
+  template <bool kBackground>
+  Lanes At(F4 du) const {
+    Lanes l;
+    if constexpr (kBackground) {
+      l.z = F4{} + WarpBuffer::kBackground;
+      l.fx = sx + du * d_sx;
+      l.fy = sy + du * d_sy;
+      l.angle = F4{};
+      l.front = I4{} - 1;
+    } else {
+      const F4 inv = inv_z + du * d_inv_z;
+      // Lanes behind the camera divide to garbage and are dropped by `front`.
+      l.z = 1.0f / inv;
+      l.fx = (sx + du * d_sx) * l.z;
+      l.fy = (sy + du * d_sy) * l.z;
+      l.angle = (angle + du * d_angle) * l.z;
+      l.front = inv > 0;
+    }
+    return l;
+  }
+};
+
 // Writes samples of one source into the target buffer (z-test: nearest surface wins;
 // background only where nothing is).
 class Rasterizer {
@@ -138,126 +170,65 @@ class Rasterizer {
     }
   }
 
-  // A surface block as TexturedQuad<false> draws it, for the common convex quad: each pixel
-  // row's span is found from the quad's edges and walked with the attributes (inverse depth,
-  // source position and angle over z) stepped along x, so no pixel of the bounding box is
-  // tested against the triangles. A centre on an edge shared with the next block is drawn
-  // by both (edges are evaluated from the same corners in the same order), so no centre
-  // falls between blocks. Folded quads take TexturedQuad.
-  void SurfaceBlock(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
-                    float side) {
-    // Perimeter a, b, d, c: convex when the four turns agree.
-    const Corner* ring[4] = {&a, &b, &d, &c};
-    float turn[4];
-    for (int k = 0; k < 4; ++k) {
-      const Corner& p = *ring[k];
-      const Corner& q = *ring[(k + 1) % 4];
-      const Corner& r = *ring[(k + 2) % 4];
-      turn[k] = (q.u - p.u) * (r.v - q.v) - (q.v - p.v) * (r.u - q.u);
-    }
-    const bool convex = (turn[0] > 0 && turn[1] > 0 && turn[2] > 0 && turn[3] > 0) ||
-                        (turn[0] < 0 && turn[1] < 0 && turn[2] < 0 && turn[3] < 0);
-    if (!convex) {
-      TexturedQuad<false>(a, b, c, d, side);
-      return;
-    }
+  // Triangles (a, b, c) and (b, d, c) of a square block of `side` x `side` source pixels of one
+  // continuous surface (or of background, kBackground), its colour sampled from the source at
+  // the interpolated source position (so a block larger than one pixel keeps the texture's
+  // detail). Surfaces are perspective-correct, background screen-affine.
+  //
+  // Drawn by inverse mapping: every pixel of the block's bounding box is mapped through each
+  // triangle to a source position relative to a's, (fx, fy), and the triangle covers the pixel
+  // when that position lies in its half of the source square: fx, fy >= 0 and fx + fy <= side
+  // for the first, fx, fy <= side and fx + fy >= side for the second. That is the barycentric
+  // inside test (source position is affine in the perspective-correct weights), but it needs
+  // no edge setup and runs four pixels at a time. The slack is far above float rounding, so a
+  // centre on an edge shared with the next block is drawn by both, never by neither.
+  template <bool kBackground>
+  void TexturedBlock(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
+                     float side) {
     Box box;
     if (!ClipQuad(a, b, c, d, &box)) return;
+    // Source positions relative to a's: the inside tests compare them with 0 and side, where
+    // float keeps them exact to ~1e-7 of the block.
+    Corner local[4] = {a, b, c, d};
+    for (Corner& k : local) {
+      k.sx -= a.sx;
+      k.sy -= a.sy;
+    }
     const float source_area2 = side * side;
     TriangleSetup first, second;
-    if (!first.Init<false>(a, b, c, source_area2) || !second.Init<false>(b, d, c, source_area2)) {
-      TexturedQuad<false>(a, b, c, d, side);
-      return;
-    }
+    const bool valid_1 = first.Init<kBackground>(local[0], local[1], local[2], source_area2);
+    const bool valid_2 = second.Init<kBackground>(local[1], local[3], local[2], source_area2);
+    if (!valid_1 && !valid_2) return;
     const AttributePlanes planes[2] = {AttributePlanes(first, a.u, a.v),
                                        AttributePlanes(second, a.u, a.v)};
-    // Side of the diagonal b-c: a's side is the first triangle.
-    const float diag_u = c.u - b.u, diag_v = c.v - b.v;
-    const float a_side = diag_u * (a.v - b.v) - diag_v * (a.u - b.u);
-    // Each edge from its upper corner (smaller v, then smaller u) down, so a shared edge
-    // gives the same crossings in both blocks; u at a row is top.u + (v - top.v) * slope.
-    struct Edge {
-      float top_u, top_v, bottom_v, slope, u_min, u_max;
-    };
-    Edge edges[4];
-    for (int k = 0; k < 4; ++k) {
-      const Corner* p = ring[k];
-      const Corner* q = ring[(k + 1) % 4];
-      if (q->v < p->v || (q->v == p->v && q->u < p->u)) std::swap(p, q);
-      const float dv = q->v - p->v;
-      edges[k] = {p->u, p->v, q->v, dv > 0 ? (q->u - p->u) / dv : 0.0f, std::min(p->u, q->u),
-                  std::max(p->u, q->u)};
-    }
+    const float slack = 1e-5f * side;
+    const I4 use_1 = I4{} + (valid_1 ? -1 : 0), use_2 = I4{} + (valid_2 ? -1 : 0);
+    const F4 lane = {0.5f, 1.5f, 2.5f, 3.5f};
     for (int y = box.y0; y <= box.y1; ++y) {
-      const float pv = static_cast<float>(y) + 0.5f;
-      float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-      for (const Edge& e : edges) {
-        if (!(pv >= e.top_v && pv <= e.bottom_v)) continue;
-        // Horizontal edges (bottom_v == top_v) span their whole length.
-        const float u = e.bottom_v > e.top_v ? e.top_u + (pv - e.top_v) * e.slope : e.u_min;
-        const float u_far = e.bottom_v > e.top_v ? u : e.u_max;
-        lo = std::min(lo, u);
-        hi = std::max(hi, u_far);
-      }
-      if (!(lo <= hi)) continue;
-      Box span;
-      if (!Clip(lo, hi, pv, pv, &span)) continue;
-      const float dv = pv - a.v;
-      for (int x = span.x0; x <= span.x1; ++x) {
-        const float pu = static_cast<float>(x) + 0.5f;
-        const float side_of = diag_u * (pv - b.v) - diag_v * (pu - b.u);
-        const AttributePlanes& t = planes[(side_of > 0) == (a_side > 0) ? 0 : 1];
-        const float du = pu - a.u;
-        const float inv_z = t.inv_z.At(du, dv);
-        if (!(inv_z > 0)) continue;
-        const float z = 1.0f / inv_z;
-        const size_t i = Index(x, y);
-        if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
-        WriteSample(i, z, t.sx.At(du, dv) * z, t.sy.At(du, dv) * z, t.angle.At(du, dv) * z,
-                    t.stretch);
-      }
-    }
-  }
-
-  // Triangles (a, b, c) and (b, d, c) of a square block of `side` x `side` source pixels of one
-  // continuous surface (or of background, kBackground), its colour sampled bilinearly from
-  // the source at the interpolated source position (so a block larger than one pixel keeps
-  // the texture's detail). Surfaces are perspective-correct, background screen-affine.
-  template <bool kBackground>
-  void TexturedQuad(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
-                    float side) {
-    Box box;
-    if (!ClipQuad(a, b, c, d, &box)) return;
-    // Source triangles have area side^2 / 2: the area ratio is |area2| / side^2.
-    const float source_area2 = side * side;
-    TriangleSetup first, second;
-    const bool valid_1 = first.Init<kBackground>(a, b, c, source_area2);
-    const bool valid_2 = second.Init<kBackground>(b, d, c, source_area2);
-    for (int y = box.y0; y <= box.y1; ++y) {
-      const float pv = static_cast<float>(y) + 0.5f;
-      for (int x = box.x0; x <= box.x1; ++x) {
-        const float pu = static_cast<float>(x) + 0.5f;
-        float w[3];
-        const TriangleSetup* t = nullptr;
-        if (valid_1 && first.Inside(pu, pv, w)) {
-          t = &first;
-        } else if (valid_2 && second.Inside(pu, pv, w)) {
-          t = &second;
-        } else {
-          continue;
-        }
-        const size_t i = Index(x, y);
-        if constexpr (kBackground) {
-          if (depth_[i] != 0) continue;
-          WriteSample(i, WarpBuffer::kBackground, t->Attribute(t->sx, w),
-                      t->Attribute(t->sy, w), 0.0f, t->stretch);
-        } else {
-          const float inv_z = t->Attribute(t->inv_z, w);
-          if (!(inv_z > 0)) continue;
-          const float z = 1.0f / inv_z;
-          if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
-          WriteSample(i, z, t->Attribute(t->sx, w) * z, t->Attribute(t->sy, w) * z,
-                      t->Attribute(t->angle, w) * z, t->stretch);
+      const float dv = static_cast<float>(y) + 0.5f - a.v;
+      const RowPlanes row_1(planes[0], dv), row_2(planes[1], dv);
+      for (int x = box.x0; x <= box.x1; x += 4) {
+        const F4 du = (static_cast<float>(x) - a.u) + lane;
+        Lanes lanes_1 = row_1.At<kBackground>(du), lanes_2 = row_2.At<kBackground>(du);
+        const I4 in_1 = use_1 & lanes_1.front & (lanes_1.fx >= -slack) & (lanes_1.fy >= -slack) &
+                        (lanes_1.fx + lanes_1.fy <= side + slack);
+        const I4 in_2 = use_2 & lanes_2.front & (lanes_2.fx <= side + slack) &
+                        (lanes_2.fy <= side + slack) & (lanes_2.fx + lanes_2.fy >= side - slack);
+        const int count = std::min(4, box.x1 - x + 1);
+        for (int k = 0; k < count; ++k) {
+          const bool on_1 = in_1[k] != 0;
+          if (!on_1 && in_2[k] == 0) continue;
+          const Lanes& l = on_1 ? lanes_1 : lanes_2;
+          const size_t i = Index(x + k, y);
+          const float stretch = on_1 ? first.stretch : second.stretch;
+          if constexpr (kBackground) {
+            if (depth_[i] != 0) continue;
+            WriteSample(i, WarpBuffer::kBackground, a.sx + l.fx[k], a.sy + l.fy[k], 0.0f, stretch);
+          } else {
+            const float z = l.z[k];
+            if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
+            WriteSample(i, z, a.sx + l.fx[k], a.sy + l.fy[k], l.angle[k], stretch);
+          }
         }
       }
     }
