@@ -182,6 +182,7 @@ void Bench::Render() {
     std::string fill;
     int hole_sources = 0;  // More sources while holes remain (render --hole-sources).
     bool baseline = false;
+    std::string texture_filter = "auto";  // render --texture-filter.
   };
   std::vector<Setting> settings;
   for (const std::string warp : {"mesh", "splat"}) {
@@ -189,22 +190,26 @@ void Bench::Render() {
   }
   settings.push_back({"mesh", 4, "depth-aware", 1});
   settings.push_back({"mesh", 4, "depth-aware", 2});  // The default.
+  settings.push_back({"mesh", 4, "depth-aware", 2, false, "bicubic"});
   settings.push_back({"mesh", 4, "none"});
   settings.push_back({"mesh", 4, "inpaint"});
   settings.push_back({"naive", 1, "inpaint", 0, true});
   for (const Setting& setting : settings) {
+    const bool bicubic = setting.texture_filter != "auto";
     const std::string id = setting.warp + "_k" + std::to_string(setting.sources) + "_h" +
-                           std::to_string(setting.hole_sources) + "_" + setting.fill;
+                           std::to_string(setting.hole_sources) + "_" + setting.fill +
+                           (bicubic ? "_" + setting.texture_filter : "");
     ChildRun run;
     const nlohmann::json json = Evaluate(
         "render_" + id, KnownWorkspace(),
         {"--gt-sources", "--novel-only", "--sources", std::to_string(setting.sources),
          "--hole-sources", std::to_string(setting.hole_sources), "--warp", setting.warp,
-         "--fill", setting.fill},
+         "--fill", setting.fill, "--texture-filter", setting.texture_filter},
         &run);
     rows.push_back({"render", setting.baseline ? "naive" : "parallax",
                     "warp=" + setting.warp + " K=" + std::to_string(setting.sources) +
-                        " hole-sources=" + std::to_string(setting.hole_sources) + " fill=" + setting.fill,
+                        " hole-sources=" + std::to_string(setting.hole_sources) + " fill=" + setting.fill +
+                        (bicubic ? " texture-filter=" + setting.texture_filter : ""),
                     {{"psnr", At(json, "novel", "psnr_mean")},
                      {"ssim", At(json, "novel", "ssim_mean")},
                      {"psnr_valid", At(json, "novel", "psnr_valid_mean")},

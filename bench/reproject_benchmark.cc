@@ -1,5 +1,5 @@
 // Render timings on example_images/courtyard (640x480, ground-truth depth): a novel view from
-// its K best training views, per warp method and fill method; and the same scene at
+// its K best training views, per warp method, texture filter and fill method; and the same scene at
 // 1920x1080 (every view upsampled 3x, bilinear colour, nearest depth, and cropped to 16:9).
 // The hot loops alone too: one forward warp, the blend of four, classification and filling.
 // Counter: target pixels / s.
@@ -106,7 +106,8 @@ std::vector<const SourceView*> Sources(const Scene& scene, const PosedCamera& ta
   return sources;
 }
 
-void BM_Render(benchmark::State& state, WarpMethod method, FillMethod fill, bool hd = false) {
+void BM_Render(benchmark::State& state, WarpMethod method, FillMethod fill, bool hd = false,
+               TextureFilter filter = TextureFilter::kAuto) {
   const Scene& scene = hd ? CourtyardHd() : Courtyard();
   const PosedCamera& target = scene.novel.front();
   const std::vector<const SourceView*> sources =
@@ -114,6 +115,7 @@ void BM_Render(benchmark::State& state, WarpMethod method, FillMethod fill, bool
   RenderOptions options;
   options.warp.method = method;
   options.fill.method = fill;
+  options.warp.texture_filter = filter;
   double warp_ms = 0, blend_ms = 0, classify_ms = 0, fill_ms = 0;
   // Frames of a camera path: buffers are reused, as a viewer or `render --path` would.
   Renderer renderer(options);
@@ -225,6 +227,9 @@ BENCHMARK_CAPTURE(BM_ForwardWarp, splat, WarpMethod::kSplat)->Unit(benchmark::kM
 BENCHMARK_CAPTURE(BM_Render, mesh_depth_aware, WarpMethod::kMesh, FillMethod::kDepthAware)
     ->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Render, splat_depth_aware, WarpMethod::kSplat, FillMethod::kDepthAware)
+    ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Render, mesh_bicubic_depth_aware, WarpMethod::kMesh, FillMethod::kDepthAware,
+                  false, TextureFilter::kBicubic)
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Render, mesh_no_fill, WarpMethod::kMesh, FillMethod::kNone)
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -506,7 +506,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
 
   // Rasterisation of one source is serial: triangles from anywhere in the source can land on
   // any target pixel. Sources run in parallel into their own buffers (see Render).
-  Rasterizer raster(buffer, source.color);
+  Rasterizer raster(buffer, source.color, options.texture_filter);
   SourceWarper warper(source, setup, vertices, options, &raster);
   if (options.method == WarpMethod::kMesh) {
     data.continuous.resize(count);

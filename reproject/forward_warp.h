@@ -14,8 +14,10 @@ enum class WarpMethod {
   kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
   kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct; flat
            // 4x4 or 2x2 blocks of one surface (or of background) as one quad, the colour
-           // sampled bilinearly from the source at the interpolated source position.
+           // sampled from the source at the interpolated source position (TextureFilter).
 };
+
+enum class TextureFilter { kAuto, kBicubic };  // See ForwardWarpOptions::texture_filter.
 
 struct ForwardWarpOptions {
   WarpMethod method = WarpMethod::kMesh;
@@ -40,6 +42,11 @@ struct ForwardWarpOptions {
   // pixels (>= 1: no test). The sky's steps are well below 1%; textured ground the depth
   // stage missed has larger ones and stays unknown instead of being warped to infinity.
   double background_max_step = 0.05;
+  // Mesh: colour sampling of the source. kAuto: Catmull-Rom where the target magnifies the source
+  // (more than 1.5 target pixels per source pixel), bilinear elsewhere. kBicubic: Catmull-Rom
+  // everywhere, sharper where a sample falls between source pixels (courtyard, ground-truth
+  // sources: 31.99 -> 32.12 dB) at ~2 ms more per 640x480 warp.
+  TextureFilter texture_filter = TextureFilter::kAuto;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <utility>
 
@@ -149,8 +150,9 @@ struct RowPlanes {
 // background only where nothing is).
 class Rasterizer {
  public:
-  Rasterizer(WarpBuffer* buffer, const Image& texture)
-      : width_(buffer->Width()),
+  Rasterizer(WarpBuffer* buffer, const Image& texture, TextureFilter filter)
+      : bicubic_min_stretch_(filter == TextureFilter::kBicubic ? 0.0f : kMagnifiedStretch),
+        width_(buffer->Width()),
         height_(buffer->Height()),
         depth_(buffer->MutableDepth()),
         color_(buffer->MutableColor()),
@@ -361,8 +363,8 @@ class Rasterizer {
   void WriteSample(size_t i, float depth, float sx, float sy, float angle, float stretch) {
     depth_[i] = depth;
     weight_[i] = WarpWeight{angle, stretch};
-    if (stretch > kMagnifiedStretch && sx >= 1 && sy >= 1 &&
-        sx < static_cast<float>(texture_width_ - 2) && sy < static_cast<float>(texture_height_ - 2)) {
+    if (stretch > bicubic_min_stretch_ && sx >= 1 && sy >= 1 &&
+        sx < static_cast<float>(texture_width_ - 2) && sy < static_cast<float>(texture_height_ - 3)) {
       Bicubic(i, sx, sy);
       return;
     }
@@ -385,25 +387,32 @@ class Rasterizer {
     }
   }
 
-  // Where the target samples the source more densely than its pixels (magnified), bilinear
-  // interpolation blurs the texture: Catmull-Rom over 4 x 4 source pixels keeps it sharper.
-  // Inside the image by at least one pixel (the caller checks).
+  // Where the target samples the source more densely than its pixels (magnified), and
+  // between pixels generally, bilinear interpolation blurs the texture: Catmull-Rom over
+  // 4 x 4 source pixels keeps it sharper. Inside the image by at least one pixel, and a row
+  // above the last, so that the last tap's 4-lane load stays inside (the caller checks).
   void Bicubic(size_t i, float sx, float sy) {
     const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
     float wx[4], wy[4];
     CatmullRom(sx - static_cast<float>(x0), wx);
     CatmullRom(sy - static_cast<float>(y0), wy);
-    float rgb[3] = {0, 0, 0};
+    F4 rgb{};
     for (int r = 0; r < 4; ++r) {
       const float* row = texture_ + 3 * (static_cast<size_t>(y0 - 1 + r) * static_cast<size_t>(texture_width_) +
                                          static_cast<size_t>(x0 - 1));
-      for (int c = 0; c < 4; ++c) {
-        const float w = wx[c] * wy[r];
-        for (int k = 0; k < 3; ++k) rgb[k] += w * row[3 * c + k];
-      }
+      const F4 across = wx[0] * Load4(row) + wx[1] * Load4(row + 3) + wx[2] * Load4(row + 6) +
+                        wx[3] * Load4(row + 9);
+      rgb += wy[r] * across;
     }
     // The kernel's negative lobes can undershoot below black.
     for (int k = 0; k < 3; ++k) color_[3 * i + k] = std::max(rgb[k], 0.0f);
+  }
+
+  // An RGB pixel and the next pixel's R in the fourth lane (the caller drops it).
+  static F4 Load4(const float* p) {
+    F4 value;
+    std::memcpy(&value, p, sizeof(value));
+    return value;
   }
 
   static void CatmullRom(float t, float w[4]) {
@@ -414,9 +423,10 @@ class Rasterizer {
     w[3] = 0.5f * (t3 - t2);
   }
 
-  // Target pixels per source pixel above which a sample is drawn bicubic.
+  // Target pixels per source pixel above which TextureFilter::kAuto draws a sample bicubic.
   static constexpr float kMagnifiedStretch = 1.5f;
 
+  float bicubic_min_stretch_;  // Bicubic above this stretch (where inside by a pixel).
   int width_;
   int height_;
   float* depth_;
