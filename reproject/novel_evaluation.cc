@@ -48,10 +48,11 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
                                    const SourceSelectionOptions& selection,
                                    const RenderOptions& options, const fs::path& comparison_dir) {
   NovelEvaluation evaluation;
+  Renderer renderer(options);
   for (size_t i = 0; i < targets.size(); ++i) {
     const fs::path truth_path = truth.images / truth_image_names.at(i);
     const Image truth_image = ReadImage(truth_path);
-    const NovelView view = RenderNovelView(library, targets[i], selection, options);
+    const NovelView view = RenderNovelView(library, targets[i], selection, renderer);
     const Image render = LinearToSrgb(view.result.color);
     if (truth_image.Width() != render.Width() || truth_image.Height() != render.Height() ||
         truth_image.Channels() < 3) {

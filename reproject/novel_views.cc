@@ -239,7 +239,7 @@ std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedC
 }
 
 NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
-                          const SourceSelectionOptions& selection, const RenderOptions& options) {
+                          const SourceSelectionOptions& selection, Renderer& renderer) {
   using Clock = std::chrono::steady_clock;
   const auto select_start = Clock::now();
   std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
@@ -251,12 +251,12 @@ NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   std::vector<const SourceView*> sources;
   for (int index : chosen) sources.push_back(&library.Load(index));
   Clock::duration spent = select_end - select_start;
-  Renderer renderer(options);
   auto render_start = Clock::now();
   view.result = renderer.Render(sources, target.camera);
   spent += Clock::now() - render_start;
   // More sources, one at a time, while holes remain and some source sees into them.
-  const int hole_sources = options.fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
+  const int hole_sources =
+      renderer.Options().fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
   for (int extra = 0; extra < hole_sources; ++extra) {
     if (view.result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
     const auto pick_start = Clock::now();

@@ -57,6 +57,8 @@ class Renderer {
   // before any Render, std::invalid_argument like Render for a bad source.
   RenderResult RenderWithOneMore(const SourceView& source);
 
+  const RenderOptions& Options() const { return options_; }
+
  private:
   // Blends the warped buffers, classifies and fills; `start` is when the render began.
   RenderResult Finish(std::chrono::steady_clock::time_point start, double warp_ms);
