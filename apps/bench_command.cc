@@ -208,7 +208,8 @@ void Bench::Render() {
         &run);
     rows.push_back({"render", setting.baseline ? "naive" : "parallax",
                     "warp=" + setting.warp + " K=" + std::to_string(setting.sources) +
-                        " hole-sources=" + std::to_string(setting.hole_sources) + " fill=" + setting.fill +
+                        " hole-sources=" + std::to_string(setting.hole_sources) +
+                        " fill=" + setting.fill +
                         (bicubic ? " texture-filter=" + setting.texture_filter : ""),
                     {{"psnr", At(json, "novel", "psnr_mean")},
                      {"ssim", At(json, "novel", "ssim_mean")},

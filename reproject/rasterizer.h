@@ -364,7 +364,8 @@ class Rasterizer {
     depth_[i] = depth;
     weight_[i] = WarpWeight{angle, stretch};
     if (stretch > bicubic_min_stretch_ && sx >= 1 && sy >= 1 &&
-        sx < static_cast<float>(texture_width_ - 2) && sy < static_cast<float>(texture_height_ - 3)) {
+        sx < static_cast<float>(texture_width_ - 2) &&
+        sy < static_cast<float>(texture_height_ - 3)) {
       Bicubic(i, sx, sy);
       return;
     }

@@ -299,7 +299,8 @@ TEST(ForwardWarp, BicubicTextureFilterKeepsFineTextureSharper) {
   const double pixel_m = depth / focal;
   Scene scene;
   scene.planes.push_back(test::WallAt(depth, [&](const Eigen::Vector3d& p) {
-    const float stripe = static_cast<float>(0.3 * std::sin(2 * test::kPi * p.x() / (period_px * pixel_m)));
+    const double phase = 2 * test::kPi * p.x() / (period_px * pixel_m);
+    const float stripe = static_cast<float>(0.3 * std::sin(phase));
     return Eigen::Vector3f(0.5f + stripe, 0.5f, 0.5f - stripe);
   }));
   const SourceView source = test::RenderView(scene, CameraAt(TestCamera(), {0, 0, 0}));
