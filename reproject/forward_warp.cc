@@ -497,10 +497,11 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
     Allocate(&vertices.kind, count);
     vertices.capacity = count;
   }
+  const uint8_t* background =
+      data.background_used != nullptr ? data.background_used->data() : nullptr;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      ProjectRow(setup, source, data.background_used != nullptr ? data.background_used->data() : nullptr,
-                 data.ray_x.data(), y, &vertices);
+      ProjectRow(setup, source, background, data.ray_x.data(), y, &vertices);
     }
   });
 

@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <utility>
 
 #include "core/image.h"
 #include "reproject/forward_warp.h"
@@ -211,7 +210,7 @@ class Rasterizer {
       const RowPlanes row_1(planes[0], dv), row_2(planes[1], dv);
       for (int x = box.x0; x <= box.x1; x += 4) {
         const F4 du = (static_cast<float>(x) - a.u) + lane;
-        Lanes lanes_1 = row_1.At<kBackground>(du), lanes_2 = row_2.At<kBackground>(du);
+        const Lanes lanes_1 = row_1.At<kBackground>(du), lanes_2 = row_2.At<kBackground>(du);
         const I4 in_1 = use_1 & lanes_1.front & (lanes_1.fx >= -slack) & (lanes_1.fy >= -slack) &
                         (lanes_1.fx + lanes_1.fy <= side + slack);
         const I4 in_2 = use_2 & lanes_2.front & (lanes_2.fx <= side + slack) &
@@ -228,7 +227,7 @@ class Rasterizer {
             WriteSample(i, WarpBuffer::kBackground, a.sx + l.fx[k], a.sy + l.fy[k], 0.0f, stretch);
           } else {
             const float z = l.z[k];
-            if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) continue;
+            if (!Nearer(i, z) || !Finite(z)) continue;
             WriteSample(i, z, a.sx + l.fx[k], a.sy + l.fy[k], l.angle[k], stretch);
           }
         }
@@ -265,7 +264,7 @@ class Rasterizer {
     for (int y = box.y0; y <= box.y1; ++y) {
       for (int x = box.x0; x <= box.x1; ++x) {
         const size_t i = Index(x, y);
-        if (background ? depth_[i] != 0 : (depth_[i] != 0 && !(z < depth_[i]))) continue;
+        if (background ? depth_[i] != 0 : !Nearer(i, z)) continue;
         Write(i, z, q, a, a, a, stretch);
       }
     }
@@ -282,6 +281,9 @@ class Rasterizer {
   size_t Index(int x, int y) const {
     return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
   }
+
+  // The z-test: target pixel i is empty or holds something farther than z.
+  bool Nearer(size_t i, float z) const { return depth_[i] == 0 || z < depth_[i]; }
 
   // Source triangles have area 1/2, so the area ratio is twice the target area: |area2|.
   static float Stretch(float inv_area) { return std::abs(1.0f / inv_area); }
@@ -304,7 +306,7 @@ class Rasterizer {
     if (!(inv_z > 0)) return true;
     const float z = 1.0f / inv_z;
     const size_t i = Index(x, y);
-    if ((depth_[i] != 0 && !(z < depth_[i])) || !Finite(z)) return true;
+    if (!Nearer(i, z) || !Finite(z)) return true;
     const float q[3] = {w[0] * a.inv_z * z, w[1] * b.inv_z * z, w[2] * c.inv_z * z};
     Write(i, z, q, a, b, c, stretch);
     return true;

@@ -22,11 +22,16 @@ Camera TestCamera(int width = 160, int height = 120, double focal = 150) {
                            focal, width / 2.0, height / 2.0);
 }
 
-// A red box 4..5 in front of a blue wall at 8.
+// A red box 4..5 in front of the camera.
+test::Box RedBox() {
+  return {{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)};
+}
+
+// The red box in front of a blue wall at 8.
 Scene BoxScene() {
   Scene scene;
   scene.planes.push_back(test::WallAt(8, test::WavyTexture({0.1f, 0.2f, 0.7f}, 0.8)));
-  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
+  scene.boxes.push_back(RedBox());
   return scene;
 }
 
@@ -196,11 +201,17 @@ Eigen::Vector3f SkyColor(const Eigen::Vector3d& dir) {
                          static_cast<float>(0.5 + 0.4 * dir.y() / dir.z()), 0.3f);
 }
 
+// The red box against the sky.
+Scene BoxInSky() {
+  Scene scene;
+  scene.boxes.push_back(RedBox());
+  scene.sky = SkyColor;
+  return scene;
+}
+
 TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
   const Camera camera = TestCamera(160, 120, 150);
-  Scene scene;
-  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
-  scene.sky = SkyColor;
+  const Scene scene = BoxInSky();
   const PosedCamera source_camera = CameraAt(camera, {0, 0, 0});
   const SourceView source = test::RenderView(scene, source_camera);
   const Eigen::Quaterniond rotation(Eigen::AngleAxisd(0.08, Eigen::Vector3d(0.2, 1, 0.1).normalized()));
@@ -248,9 +259,7 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
 // marks itself; a mask made with another colour step is not used.
 TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
   const Camera camera = TestCamera(160, 120, 150);
-  Scene scene;
-  scene.boxes.push_back({{-0.5, -0.4, 4}, {0.5, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
-  scene.sky = SkyColor;
+  const Scene scene = BoxInSky();
   SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
   const PosedCamera target = CameraAt(camera, {0.3, -0.1, 0.2});
   const auto warp = [&](const SourceView& view) {
