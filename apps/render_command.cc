@@ -140,8 +140,9 @@ void RegisterRenderCommand(CLI::App& app) {
     double hole_sum = 0, filled_sum = 0, ms_sum = 0;
     std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.
     Renderer renderer(render_options);
+    NovelView view;
     for (size_t i = 0; i < targets.size(); ++i) {
-      const NovelView view = RenderNovelView(library, targets[i], selection, renderer);
+      RenderNovelView(library, targets[i], selection, renderer, &view);
       WriteNovelView(arguments->out, targets[i].name, view.result);
       csv += CsvRow(targets[i].name, view);
       hole_sum += view.result.metrics.hole_ratio;

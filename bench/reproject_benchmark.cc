@@ -119,8 +119,9 @@ void BM_Render(benchmark::State& state, WarpMethod method, FillMethod fill, bool
   double warp_ms = 0, blend_ms = 0, classify_ms = 0, fill_ms = 0;
   // Frames of a camera path: buffers are reused, as a viewer or `render --path` would.
   Renderer renderer(options);
+  RenderResult result;
   for (auto _ : state) {
-    const RenderResult result = renderer.Render(sources, target);
+    renderer.Render(sources, target, &result);
     benchmark::DoNotOptimize(result.color.Pixels().data());
     warp_ms += result.timings.warp_ms;
     blend_ms += result.timings.blend_ms;
@@ -187,8 +188,9 @@ void SetPixelRate(benchmark::State& state, const PosedCamera& target) {
 // Four warped sources blended into the target (front-most surface with support, weights).
 void BM_Blend(benchmark::State& state) {
   const WarpedSources& warped = WarpedForBlend();
+  BlendResult blend;  // Reused, as the renderer reuses its own.
   for (auto _ : state) {
-    const BlendResult blend = Blend(warped.buffers, {});
+    Blend(warped.buffers, {}, &blend);
     benchmark::DoNotOptimize(blend.color.Pixels().data());
   }
   SetPixelRate(state, Courtyard().novel.front());
@@ -198,7 +200,8 @@ void BM_Blend(benchmark::State& state) {
 void BM_ClassifyAndFill(benchmark::State& state) {
   const WarpedSources& warped = WarpedForBlend();
   const PosedCamera& target = Courtyard().novel.front();
-  const BlendResult blended = Blend(warped.buffers, {});
+  BlendResult blended;
+  Blend(warped.buffers, {}, &blended);
   std::vector<ClassifySource> sources;
   for (size_t i = 0; i < warped.sources.size(); ++i) {
     sources.push_back({warped.sources[i]->Posed(), &warped.sources[i]->depth, &warped.scratch[i].Background()});

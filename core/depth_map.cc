@@ -68,11 +68,15 @@ int ParseHeaderField(const std::string& bytes, size_t& position, const fs::path&
 
 }  // namespace
 
-DepthMap::DepthMap(int width, int height) : width_(width), height_(height) {
+DepthMap::DepthMap(int width, int height) { Reset(width, height); }
+
+void DepthMap::Reset(int width, int height) {
   if (width < 0 || height < 0) {
     throw std::invalid_argument("DepthMap: invalid size " + std::to_string(width) + "x" +
                                 std::to_string(height));
   }
+  width_ = width;
+  height_ = height;
   values_.assign(static_cast<size_t>(width) * height, 0.0f);
 }
 

@@ -19,6 +19,8 @@ class DepthMap {
   DepthMap() = default;
   // Zero-filled ("no value" everywhere). Throws std::invalid_argument for negative sizes.
   DepthMap(int width, int height);
+  // As a new DepthMap(width, height), keeping the memory when it is large enough.
+  void Reset(int width, int height);
 
   int Width() const { return width_; }
   int Height() const { return height_; }

@@ -41,12 +41,16 @@ Image MapColorChannels(const Image& input, float (*function)(float)) {
 
 }  // namespace
 
-Image::Image(int width, int height, int channels)
-    : width_(width), height_(height), channels_(channels) {
+Image::Image(int width, int height, int channels) { Reset(width, height, channels); }
+
+void Image::Reset(int width, int height, int channels) {
   if (width < 0 || height < 0 || channels < 1 || channels > 4) {
     throw std::invalid_argument("Image: invalid size " + std::to_string(width) + "x" +
                                 std::to_string(height) + "x" + std::to_string(channels));
   }
+  width_ = width;
+  height_ = height;
+  channels_ = channels;
   pixels_.assign(static_cast<size_t>(width) * height * channels, 0.0f);
 }
 

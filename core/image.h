@@ -19,6 +19,9 @@ class Image {
   Image() = default;
   // Zero-filled. Throws std::invalid_argument for channels outside 1..4 or negative sizes.
   Image(int width, int height, int channels);
+  // As a new Image(width, height, channels), keeping the memory when it is large enough: a
+  // frame loop that reuses its images does not page-fault megabytes of fresh memory per frame.
+  void Reset(int width, int height, int channels);
 
   int Width() const { return width_; }
   int Height() const { return height_; }

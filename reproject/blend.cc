@@ -119,7 +119,7 @@ void BlendOptions::Check() const {
   }
 }
 
-BlendResult Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options) {
+void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, BlendResult* out) {
   options.Check();
   if (buffers.empty()) throw std::invalid_argument("Blend: no warped sources");
   const int width = buffers.front().Width(), height = buffers.front().Height();
@@ -131,20 +131,18 @@ BlendResult Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& op
                                   std::to_string(buffer.Height()));
     }
   }
-  BlendResult out;
-  out.color = Image(width, height, 3);
-  out.depth = DepthMap(width, height);
-  out.kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
+  out->color.Reset(width, height, 3);
+  out->depth.Reset(width, height);
+  out->kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
   const float tolerance = static_cast<float>(options.depth_tolerance);
   const float angle_epsilon = static_cast<float>(options.angle_epsilon_rad);
   const int min_support = options.min_support;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> scratch;
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      BlendRow(buffers, y, tolerance, angle_epsilon, min_support, &scratch, &out);
+      BlendRow(buffers, y, tolerance, angle_epsilon, min_support, &scratch, out);
     }
   });
-  return out;
 }
 
 }  // namespace parallax

@@ -50,7 +50,8 @@ struct BlendResult {
 // samples within depth_tolerance of it are averaged in linear light with Unstructured-Lumigraph-style
 // weights (smaller angle between source and target rays, less stretch -> larger weight).
 // Background samples are blended only where no surface sample landed. Parallel over rows.
+// Overwrites *out, keeping its memory when large enough (a frame loop reuses one).
 // Throws std::invalid_argument for no buffers or buffers of different sizes.
-BlendResult Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options);
+void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, BlendResult* out);
 
 }  // namespace parallax

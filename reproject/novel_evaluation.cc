@@ -49,10 +49,11 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
                                    const RenderOptions& options, const fs::path& comparison_dir) {
   NovelEvaluation evaluation;
   Renderer renderer(options);
+  NovelView view;
   for (size_t i = 0; i < targets.size(); ++i) {
     const fs::path truth_path = truth.images / truth_image_names.at(i);
     const Image truth_image = ReadImage(truth_path);
-    const NovelView view = RenderNovelView(library, targets[i], selection, renderer);
+    RenderNovelView(library, targets[i], selection, renderer, &view);
     const Image render = LinearToSrgb(view.result.color);
     if (truth_image.Width() != render.Width() || truth_image.Height() != render.Height() ||
         truth_image.Channels() < 3) {

@@ -238,8 +238,8 @@ std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedC
   return points;
 }
 
-NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
-                          const SourceSelectionOptions& selection, Renderer& renderer) {
+void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
+                     const SourceSelectionOptions& selection, Renderer& renderer, NovelView* view) {
   using Clock = std::chrono::steady_clock;
   const auto select_start = Clock::now();
   std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
@@ -247,38 +247,38 @@ NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   if (chosen.empty()) {
     throw BadInputError("render " + target.name + ": no source view sees what this camera sees");
   }
-  NovelView view;
+  view->sources.clear();
   std::vector<const SourceView*> sources;
   for (int index : chosen) sources.push_back(&library.Load(index));
   Clock::duration spent = select_end - select_start;
   auto render_start = Clock::now();
-  view.result = renderer.Render(sources, target.camera);
+  renderer.Render(sources, target.camera, &view->result);
   spent += Clock::now() - render_start;
   // More sources, one at a time, while holes remain and some source sees into them.
   const int hole_sources =
       renderer.Options().fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
   for (int extra = 0; extra < hole_sources; ++extra) {
-    if (view.result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
+    if (view->result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
     const auto pick_start = Clock::now();
     const int pick = SourceSeeingMost(library.Cameras(), target.camera,
-                                      HolePoints(view.result, target.camera), chosen,
+                                      HolePoints(view->result, target.camera), chosen,
                                       kMinHolePointsInFrame, selection);
     spent += Clock::now() - pick_start;
     if (pick < 0) break;
     const SourceView& source = library.Load(pick);
     render_start = Clock::now();
-    RenderResult more = renderer.RenderWithOneMore(source);
+    RenderResult more;
+    renderer.RenderWithOneMore(source, &more);
     spent += Clock::now() - render_start;
     // Kept only when it closes a tenth of the holes at least: else it did not see into them
     // after all (occluded as well), and the render without it stands.
-    if (!(more.metrics.hole_ratio < kKeptHoleShare * view.result.metrics.hole_ratio)) break;
+    if (!(more.metrics.hole_ratio < kKeptHoleShare * view->result.metrics.hole_ratio)) break;
     chosen.push_back(pick);
-    view.result = std::move(more);
+    view->result = std::move(more);
   }
-  for (int index : chosen) view.sources.push_back(library.Names()[static_cast<size_t>(index)]);
+  for (int index : chosen) view->sources.push_back(library.Names()[static_cast<size_t>(index)]);
   // Selection and rendering; reading files is left out (the first targets pay for all).
-  view.ms = std::chrono::duration<double, std::milli>(spent).count();
-  return view;
+  view->ms = std::chrono::duration<double, std::milli>(spent).count();
 }
 
 void WriteNovelView(const fs::path& dir, const std::string& name, const RenderResult& result) {

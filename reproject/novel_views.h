@@ -83,10 +83,10 @@ std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedC
 // that does not close a tenth of the holes (that one stays loaded, unused). HolePoints needs
 // the depth the depth-aware fill gives holes: with another fill no source is added. The
 // result's timings are those of its last render step; NovelView::ms covers them all. Throws
-// BadInputError when no source can contribute to the target. One `renderer` for all the views
-// of a run keeps its buffers: a fresh one per 640x480 view page-faults ~60 MB of them.
-NovelView RenderNovelView(SourceLibrary& library, const NamedCamera& target,
-                          const SourceSelectionOptions& selection, Renderer& renderer);
+// BadInputError when no source can contribute to the target. One `renderer` and one `view`
+// for all the views of a run keep their memory: fresh ones per 640x480 view page-fault ~65 MB.
+void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
+                     const SourceSelectionOptions& selection, Renderer& renderer, NovelView* view);
 
 // Writes <dir>/<name>.png (sRGB, after filling), <name>.holes.png (8-bit mask, 255 where a
 // crack or disocclusion was before filling) and <name>.depth.exr (0 where unknown or

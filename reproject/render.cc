@@ -3,6 +3,7 @@
 #include <chrono>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
@@ -28,11 +29,13 @@ Renderer::Renderer(const RenderOptions& options) : options_(options) { options_.
 
 RenderResult Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
                     const RenderOptions& options) {
-  return Renderer(options).Render(sources, target);
+  RenderResult result;
+  Renderer(options).Render(sources, target, &result);
+  return result;
 }
 
-RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
-                              const TargetCamera& target) {
+void Renderer::Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
+                      RenderResult* result) {
   const Clock::time_point start = Clock::now();
   if (sources.empty()) throw std::invalid_argument("Render: no source views");
   for (size_t i = 0; i < sources.size(); ++i) {
@@ -49,10 +52,10 @@ RenderResult Renderer::Render(const std::vector<const SourceView*>& sources,
   tbb::parallel_for(size_t{0}, sources.size(), [&](size_t i) {
     ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i]);
   });
-  return Finish(start, MsSince(start));
+  Finish(start, MsSince(start), result);
 }
 
-RenderResult Renderer::RenderWithOneMore(const SourceView& source) {
+void Renderer::RenderWithOneMore(const SourceView& source, RenderResult* result) {
   const Clock::time_point start = Clock::now();
   if (sources_.empty()) throw std::logic_error("Renderer::RenderWithOneMore before Render");
   CheckSourceView(source);
@@ -60,33 +63,37 @@ RenderResult Renderer::RenderWithOneMore(const SourceView& source) {
   scratch_.resize(sources_.size() + 1);
   ForwardWarp(source, target_, options_.warp, &buffers_.back(), &scratch_.back());
   sources_.push_back(&source);  // Only once warped: a throw leaves the last render's state.
-  return Finish(start, MsSince(start));
+  Finish(start, MsSince(start), result);
 }
 
-RenderResult Renderer::Finish(Clock::time_point start, double warp_ms) {
-  RenderResult result;
-  result.timings.warp_ms = warp_ms;
+void Renderer::Finish(Clock::time_point start, double warp_ms, RenderResult* result) {
+  RenderTimings timings;
+  timings.warp_ms = warp_ms;
   Clock::time_point step = Clock::now();
-  BlendResult blend = Blend(buffers_, options_.blend);
-  result.timings.blend_ms = MsSince(step);
+  Blend(buffers_, options_.blend, &blend_);
+  timings.blend_ms = MsSince(step);
 
   step = Clock::now();
   std::vector<ClassifySource> classify_sources;
   for (size_t i = 0; i < sources_.size(); ++i) {
     classify_sources.push_back({sources_[i]->Posed(), &sources_[i]->depth, &scratch_[i].Background()});
   }
-  result.classes = ClassifyPixels(blend, classify_sources, target_, options_.holes);
-  result.metrics = ComputeHoleMetrics(result.classes);
-  result.timings.classify_ms = MsSince(step);
+  ClassMap classes = ClassifyPixels(blend_, classify_sources, target_, options_.holes);
+  const HoleMetrics metrics = ComputeHoleMetrics(classes);
+  timings.classify_ms = MsSince(step);
 
   step = Clock::now();
-  result.fill = FillHoles(result.classes, target_.camera, options_.fill, &blend);
-  result.timings.fill_ms = MsSince(step);
+  const FillSummary fill = FillHoles(classes, target_.camera, options_.fill, &blend_);
+  timings.fill_ms = MsSince(step);
 
-  result.color = std::move(blend.color);
-  result.depth = std::move(blend.depth);
-  result.timings.total_ms = MsSince(start);
-  return result;
+  // Nothing above touched *result: a throw leaves it as it was.
+  std::swap(result->color, blend_.color);
+  std::swap(result->depth, blend_.depth);
+  result->classes = std::move(classes);
+  result->metrics = metrics;
+  result->fill = fill;
+  result->timings = timings;
+  result->timings.total_ms = MsSince(start);
 }
 
 }  // namespace parallax

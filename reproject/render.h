@@ -48,26 +48,33 @@ class Renderer {
  public:
   explicit Renderer(const RenderOptions& options = {});  // Throws like RenderOptions::Check.
 
-  // As the free function Render below.
-  RenderResult Render(const std::vector<const SourceView*>& sources, const TargetCamera& target);
+  // As the free function Render below, into *result. Its memory is reused: a caller that
+  // passes the same result frame after frame allocates nothing per frame (a fresh 640x480
+  // result page-faults ~5 MB, ~1.6 ms of a K=4 render). On a throw *result is unchanged.
+  void Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
+              RenderResult* result);
 
   // Renders the last Render's target again with `source` added to its sources: only `source`
   // is warped, the others' warps are kept (blending, classification and filling run again).
   // `source` and the last call's sources must outlive the next call. Throws std::logic_error
   // before any Render, std::invalid_argument like Render for a bad source.
-  RenderResult RenderWithOneMore(const SourceView& source);
+  void RenderWithOneMore(const SourceView& source, RenderResult* result);
 
   const RenderOptions& Options() const { return options_; }
 
  private:
-  // Blends the warped buffers, classifies and fills; `start` is when the render began.
-  RenderResult Finish(std::chrono::steady_clock::time_point start, double warp_ms);
+  // Blends the warped buffers, classifies and fills into *result; `start` is when the render
+  // began.
+  void Finish(std::chrono::steady_clock::time_point start, double warp_ms, RenderResult* result);
 
   RenderOptions options_;
   std::vector<WarpBuffer> buffers_;
   std::vector<WarpScratch> scratch_;
   std::vector<const SourceView*> sources_;  // Of the last render.
   TargetCamera target_;
+  // The frame being blended and filled; its colour and depth then trade places with the
+  // result's, whose memory (the caller's last frame) the next frame is blended into.
+  BlendResult blend_;
 };
 
 // Renders `target` from `sources` (at least one; each checked with CheckSourceView). Sources

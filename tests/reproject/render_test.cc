@@ -171,13 +171,38 @@ TEST(Renderer, RenderWithOneMoreEqualsRenderingAllSources) {
   const SourceView up = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0.5, 0}), "up");
   const PosedCamera target = CameraAt(BoxCamera(), {0, 0.05, 0});
   Renderer renderer(Options(WarpMethod::kMesh, FillMethod::kDepthAware));
-  EXPECT_THROW(renderer.RenderWithOneMore(up), std::logic_error);
-  renderer.Render({&left, &right}, target);
-  const RenderResult added = renderer.RenderWithOneMore(up);
+  RenderResult added;
+  EXPECT_THROW(renderer.RenderWithOneMore(up, &added), std::logic_error);
+  renderer.Render({&left, &right}, target, &added);
+  renderer.RenderWithOneMore(up, &added);
   const RenderResult all = Render({&left, &right, &up}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
   EXPECT_EQ(added.color.Pixels(), all.color.Pixels());
   EXPECT_EQ(added.depth.Values(), all.depth.Values());
   EXPECT_EQ(added.metrics.hole_ratio, all.metrics.hole_ratio);
+}
+
+// A camera path renders into one result, whose memory each frame reuses: nothing of an
+// earlier frame (another view, other holes) may show through.
+TEST(Renderer, FramesIntoOneResultEqualFreshRenders) {
+  const Scene scene = BoxScene();
+  const SourceView left = test::RenderView(scene, CameraAt(BoxCamera(), {-0.6, 0, 0}), "left");
+  const SourceView right = test::RenderView(scene, CameraAt(BoxCamera(), {0.6, 0, 0}), "right");
+  const PosedCamera near = CameraAt(BoxCamera(), {0, 0.05, 0});
+  const PosedCamera far = CameraAt(BoxCamera(), {1.5, 0.4, 0});
+  const RenderOptions options = Options(WarpMethod::kMesh, FillMethod::kDepthAware);
+  Renderer renderer(options);
+  RenderResult frame;
+  for (const PosedCamera* target : {&far, &near, &far, &near}) {
+    renderer.Render({&left, &right}, *target, &frame);
+  }
+  const RenderResult fresh = Render({&left, &right}, near, options);
+  EXPECT_EQ(frame.color.Pixels(), fresh.color.Pixels());
+  EXPECT_EQ(frame.depth.Values(), fresh.depth.Values());
+  EXPECT_EQ(frame.classes.classes, fresh.classes.classes);
+  EXPECT_EQ(frame.metrics.hole_ratio, fresh.metrics.hole_ratio);
+  // The far view's holes differ from the near view's: the test compares different frames.
+  renderer.Render({&left, &right}, far, &frame);
+  EXPECT_NE(frame.metrics.hole_ratio, fresh.metrics.hole_ratio);
 }
 
 // The hole a box leaves in a render from its left lies behind the box: of three more
@@ -227,7 +252,9 @@ TEST(Render, TargetLookingAboveTheSourcesSkyIsOutOfViewNotAHole) {
     ForwardWarp(source, target, options.warp, &buffer);
     std::vector<WarpBuffer> buffers;
     buffers.push_back(std::move(buffer));
-    return Blend(buffers, options.blend);
+    BlendResult blended;
+    Blend(buffers, options.blend, &blended);
+    return blended;
   }();
   const ClassMap frustum_only = ClassifyPixels(blend, {source.Posed()}, target, options.holes);
   const HoleMetrics frustum_metrics = ComputeHoleMetrics(frustum_only);
