@@ -13,9 +13,8 @@ namespace {
 
 // One row of the blend, buffer after buffer (each buffer's row is read as a stream).
 // `scratch` is resized to 8 floats per pixel of the row.
-void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance,
-              float angle_epsilon, int min_support, std::vector<float>* scratch,
-              BlendResult* out) {
+void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance, int min_support,
+              std::vector<float>* scratch, BlendResult* out) {
   const size_t width = static_cast<size_t>(out->color.Width());
   const size_t row = static_cast<size_t>(y) * width;
   scratch->resize(8 * width);
@@ -76,9 +75,7 @@ void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance,
       const float d = depth[x];
       if (!(d > 0 && d <= limit[x])) continue;
       const bool surface = front[x] != WarpBuffer::kBackground;
-      const WarpWeight& ww = buffer.Weight(row + x);
-      const float w =
-          1.0f / ((ww.ray_angle_rad + angle_epsilon) * std::max(1.0f, ww.stretch));
+      const float w = buffer.Weight(row + x);
       const float* color = buffer.Color(row + x);
       for (int k = 0; k < 3; ++k) rgb_sum[3 * x + static_cast<size_t>(k)] += w * color[k];
       if (surface) depth_sum[x] += w * d;
@@ -113,10 +110,6 @@ void BlendOptions::Check() const {
     throw std::invalid_argument("BlendOptions.min_support = " + std::to_string(min_support) +
                                 ": expected [1, 16]");
   }
-  if (!(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad))) {
-    throw std::invalid_argument("BlendOptions.angle_epsilon_rad = " +
-                                std::to_string(angle_epsilon_rad) + ": expected > 0");
-  }
 }
 
 void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, BlendResult* out) {
@@ -135,12 +128,11 @@ void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, 
   out->depth.Reset(width, height);
   out->kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
   const float tolerance = static_cast<float>(options.depth_tolerance);
-  const float angle_epsilon = static_cast<float>(options.angle_epsilon_rad);
   const int min_support = options.min_support;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> scratch;
     for (int y = rows.begin(); y < rows.end(); ++y) {
-      BlendRow(buffers, y, tolerance, angle_epsilon, min_support, &scratch, out);
+      BlendRow(buffers, y, tolerance, min_support, &scratch, out);
     }
   });
 }

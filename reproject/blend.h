@@ -18,10 +18,6 @@ struct BlendOptions {
   // sources 31.87 -> 31.92; on the small scene 23.39 -> 23.59 and 30.63 -> 30.88 (10%: within
   // 0.05 dB of 5%).
   double depth_tolerance = 0.05;
-  // Added to the ray angle in the weight 1 / ((angle + epsilon) * max(1, stretch)), so a
-  // source that sees the point exactly along the target ray gets a large, finite weight
-  // (radians, > 0).
-  double angle_epsilon_rad = 0.01;
   // The surface blended at a pixel is the front-most one that this many sources' samples
   // agree on (within depth_tolerance; fewer where fewer sources landed there; the front-most
   // sample when no two agree). A sample in front of what the others agree on is more often a
@@ -47,8 +43,8 @@ struct BlendResult {
 };
 
 // Per pixel: the front-most surface depth over all buffers (with min_support); the surface
-// samples within depth_tolerance of it are averaged in linear light with Unstructured-Lumigraph-style
-// weights (smaller angle between source and target rays, less stretch -> larger weight).
+// samples within depth_tolerance of it are averaged in linear light with their weights
+// (WarpBuffer::Weight: smaller angle between source and target rays, less stretch -> larger).
 // Background samples are blended only where no surface sample landed. Parallel over rows.
 // Overwrites *out, keeping its memory when large enough (a frame loop reuses one).
 // Throws std::invalid_argument for no buffers or buffers of different sizes.

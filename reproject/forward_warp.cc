@@ -31,7 +31,7 @@ struct Vertices {
   std::unique_ptr<float[]> u;       // Target pixel coordinates.
   std::unique_ptr<float[]> v;
   std::unique_ptr<float[]> inv_z;   // 1 / target z; 0 for background.
-  std::unique_ptr<float[]> angle;   // WarpWeight::ray_angle_rad.
+  std::unique_ptr<float[]> angle;   // Ray angle, as in WarpBuffer::Weight.
   std::unique_ptr<float[]> source_inv_depth;  // 1 / source depth; 0 where depth is 0.
   std::unique_ptr<uint8_t[]> kind;  // VertexKind.
   size_t capacity = 0;
@@ -427,6 +427,9 @@ void ForwardWarpOptions::Check() const {
   if (!(background_max_step > 0 && std::isfinite(background_max_step))) {
     fail("background_max_step", background_max_step, "> 0");
   }
+  if (!(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad))) {
+    fail("angle_epsilon_rad", angle_epsilon_rad, "> 0");
+  }
 }
 
 void WarpBuffer::Reset(int width, int height) {
@@ -507,7 +510,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
 
   // Rasterisation of one source is serial: triangles from anywhere in the source can land on
   // any target pixel. Sources run in parallel into their own buffers (see Render).
-  Rasterizer raster(buffer, source.color, options.texture_filter);
+  Rasterizer raster(buffer, source.color, options);
   SourceWarper warper(source, setup, vertices, options, &raster);
   if (options.method == WarpMethod::kMesh) {
     data.continuous.resize(count);

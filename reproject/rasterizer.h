@@ -149,8 +149,10 @@ struct RowPlanes {
 // background only where nothing is).
 class Rasterizer {
  public:
-  Rasterizer(WarpBuffer* buffer, const Image& texture, TextureFilter filter)
-      : bicubic_min_stretch_(filter == TextureFilter::kBicubic ? 0.0f : kMagnifiedStretch),
+  Rasterizer(WarpBuffer* buffer, const Image& texture, const ForwardWarpOptions& options)
+      : bicubic_min_stretch_(options.texture_filter == TextureFilter::kBicubic ? 0.0f
+                                                                               : kMagnifiedStretch),
+        angle_epsilon_(static_cast<float>(options.angle_epsilon_rad)),
         width_(buffer->Width()),
         height_(buffer->Height()),
         depth_(buffer->MutableDepth()),
@@ -294,7 +296,7 @@ class Rasterizer {
 
   // Writes pixel (x, y) from the triangle when its centre lies inside and passes the z-test;
   // returns whether the centre lies inside.
-  // `stretch` is the triangle's WarpWeight::stretch.
+  // `stretch` is the triangle's, as in WarpBuffer::Weight.
   bool ShadeSurface(const Corner& a, const Corner& b, const Corner& c, int x, int y,
                     float inv_area, float stretch) {
     float w[3];
@@ -358,13 +360,17 @@ class Rasterizer {
              const Corner& c, float stretch) {
     depth_[i] = depth;
     for (int k = 0; k < 3; ++k) color_[3 * i + k] = q[0] * a.rgb[k] + q[1] * b.rgb[k] + q[2] * c.rgb[k];
-    weight_[i] = WarpWeight{q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch};
+    weight_[i] = Weight(q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch);
+  }
+
+  float Weight(float angle, float stretch) const {
+    return 1.0f / ((angle + angle_epsilon_) * std::max(1.0f, stretch));
   }
 
   // A sample whose colour is the source's, bilinear at source pixel (sx, sy).
   void WriteSample(size_t i, float depth, float sx, float sy, float angle, float stretch) {
     depth_[i] = depth;
-    weight_[i] = WarpWeight{angle, stretch};
+    weight_[i] = Weight(angle, stretch);
     if (stretch > bicubic_min_stretch_ && sx >= 1 && sy >= 1 &&
         sx < static_cast<float>(texture_width_ - 2) &&
         sy < static_cast<float>(texture_height_ - 3)) {
@@ -430,11 +436,12 @@ class Rasterizer {
   static constexpr float kMagnifiedStretch = 1.5f;
 
   float bicubic_min_stretch_;  // Bicubic above this stretch (where inside by a pixel).
+  float angle_epsilon_;
   int width_;
   int height_;
   float* depth_;
   float* color_;
-  WarpWeight* weight_;
+  float* weight_;
   const float* texture_;
   int texture_width_;
   int texture_height_;
