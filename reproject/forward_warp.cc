@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -43,7 +44,6 @@ struct WarpScratch::Data {
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
   std::vector<uint8_t> edge;        // Mesh: per vertex, 1 when it is to be splatted.
-  std::vector<size_t> edge_list;    // Mesh: the vertices to splat.
   std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
 };
@@ -209,14 +209,11 @@ class SourceWarper {
   // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
   // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
   // source's stride.
-  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch,
-            std::vector<size_t>* edge_list_scratch) {
+  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch) {
     const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
     continuous_ = continuous.data();
     edge_ = edge_scratch;
-    edge_list_ = edge_list_scratch;
     edge_->assign(count, 0);
-    edge_list_->clear();
     for (int y = 0; y + 1 < height_; y += kMaxBlock) {
       for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
     }
@@ -228,11 +225,22 @@ class SourceWarper {
       MarkEdge(Index(0, y));
       MarkEdge(Index(width_ - 1, y));
     }
-    // In row-major order, as a scan of every vertex would splat them (z-test ties go the same
-    // way), without scanning every vertex.
-    std::sort(edge_list_->begin(), edge_list_->end());
-    const size_t w = static_cast<size_t>(width_);
-    for (size_t i : *edge_list_) SplatVertex(static_cast<int>(i % w), static_cast<int>(i / w));
+    // In row-major order (z-test ties go the same way on every run), eight marks at a time:
+    // most are 0.
+    const uint8_t* edge = edge_->data();
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_;) {
+        const size_t i = Index(x, y);
+        uint64_t eight = 0;
+        if (x + 8 <= width_) std::memcpy(&eight, edge + i, sizeof(eight));
+        if (x + 8 <= width_ && eight == 0) {
+          x += 8;
+          continue;
+        }
+        if (edge[i] != 0) SplatVertex(x, y);
+        ++x;
+      }
+    }
   }
 
   void Splats() {
@@ -261,12 +269,8 @@ class SourceWarper {
             static_cast<float>(p.y)};
   }
 
-  // Queues a vertex for splatting, once.
-  void MarkEdge(size_t i) {
-    if ((*edge_)[i] != 0) return;
-    (*edge_)[i] = 1;
-    edge_list_->push_back(i);
-  }
+  // Marks a vertex for splatting.
+  void MarkEdge(size_t i) { (*edge_)[i] = 1; }
 
   static constexpr int kMaxBlock = 4;
   // Relative inverse-depth deviation from the corners' blend within which a block is flat:
@@ -405,7 +409,6 @@ class SourceWarper {
   int height_;
   const uint8_t* continuous_ = nullptr;
   std::vector<uint8_t>* edge_ = nullptr;
-  std::vector<size_t>* edge_list_ = nullptr;
 };
 
 template <typename T>
@@ -519,7 +522,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
         ContinuousRow(source, setup, vertices, y, data.continuous.data());
       }
     });
-    warper.Mesh(data.continuous, &data.edge, &data.edge_list);
+    warper.Mesh(data.continuous, &data.edge);
   } else {
     warper.Splats();
   }
