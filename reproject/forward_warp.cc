@@ -182,17 +182,34 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices&
     std::fill(out + row, out + row + static_cast<size_t>(width), uint8_t{0});
     return;
   }
-  const float* depth = source.depth.Values().data();
-  const size_t below = row + static_cast<size_t>(width);
-  for (int x = 0; x + 1 < width; ++x) {
-    const size_t a = row + static_cast<size_t>(x), c = below + static_cast<size_t>(x);
-    const bool surface = (vtx.kind[a] & vtx.kind[a + 1] & vtx.kind[c] & vtx.kind[c + 1]) == kSurface;
-    const float lo = std::min(std::min(depth[a], depth[a + 1]), std::min(depth[c], depth[c + 1]));
-    const float hi = std::max(std::max(depth[a], depth[a + 1]), std::max(depth[c], depth[c + 1]));
-    const bool sky = (vtx.kind[a] & vtx.kind[a + 1] & vtx.kind[c] & vtx.kind[c + 1]) == kSky;
-    out[a] = surface && hi <= s.max_depth_ratio * lo ? kSurface : sky ? kSky : kInvalid;
+  // In three passes that each vectorise (a loop mixing float and byte lanes does not, on
+  // SSE2): the depth test per quad as int32, then as bytes, then with the kinds. The kinds
+  // AND to kSurface or kSky when all four agree (1 & 2 == 0), else to kInvalid; a surface quad
+  // failing the depth test becomes kInvalid by clearing bit 0 (kSky keeps its bit 1).
+  const float* __restrict depth = source.depth.Values().data() + row;
+  const float* __restrict depth_below = depth + width;
+  const uint8_t* __restrict kind = vtx.kind.get() + row;
+  const uint8_t* __restrict kind_below = kind + width;
+  uint8_t* __restrict quad = out + row;
+  const float max_ratio = s.max_depth_ratio;
+  constexpr int kChunk = 64;
+  int32_t one_surface[kChunk];
+  uint8_t keep[kChunk];
+  for (int chunk = 0; chunk + 1 < width; chunk += kChunk) {
+    const int n = std::min(width - 1 - chunk, kChunk);
+    const float* d = depth + chunk;
+    const float* e = depth_below + chunk;
+    for (int k = 0; k < n; ++k) {
+      const float lo = std::min(std::min(d[k], d[k + 1]), std::min(e[k], e[k + 1]));
+      const float hi = std::max(std::max(d[k], d[k + 1]), std::max(e[k], e[k + 1]));
+      one_surface[k] = hi <= max_ratio * lo ? 0xFF : 0xFE;
+    }
+    for (int k = 0; k < n; ++k) keep[k] = static_cast<uint8_t>(one_surface[k]);
+    const uint8_t* p = kind + chunk;
+    const uint8_t* q = kind_below + chunk;
+    for (int k = 0; k < n; ++k) quad[chunk + k] = p[k] & p[k + 1] & q[k] & q[k + 1] & keep[k];
   }
-  out[row + static_cast<size_t>(width) - 1] = 0;
+  quad[width - 1] = 0;
 }
 
 class SourceWarper {
