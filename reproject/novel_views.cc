@@ -161,7 +161,7 @@ SourceLibrary::SourceLibrary(ViewSetPaths paths) : paths_(std::move(paths)) {
   loaded_.resize(cameras_.size());
 }
 
-const SourceView& SourceLibrary::Load(int index) {
+const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp) {
   std::unique_ptr<SourceView>& slot = loaded_.at(static_cast<size_t>(index));
   if (!slot) {
     auto view = std::make_unique<SourceView>();
@@ -181,7 +181,7 @@ const SourceView& SourceLibrary::Load(int index) {
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     CheckSourceView(*view);
-    MarkSourceBackground(view.get());
+    if (warp.background_at_infinity) MarkSourceBackground(view.get(), warp);
     slot = std::move(view);
   }
   return *slot;
@@ -249,7 +249,8 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   }
   view->sources.clear();
   std::vector<const SourceView*> sources;
-  for (int index : chosen) sources.push_back(&library.Load(index));
+  const ForwardWarpOptions& warp = renderer.Options().warp;
+  for (int index : chosen) sources.push_back(&library.Load(index, warp));
   Clock::duration spent = select_end - select_start;
   auto render_start = Clock::now();
   renderer.Render(sources, target.camera, &view->result);
@@ -265,7 +266,7 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                                       kMinHolePointsInFrame, selection);
     spent += Clock::now() - pick_start;
     if (pick < 0) break;
-    const SourceView& source = library.Load(pick);
+    const SourceView& source = library.Load(pick, warp);
     render_start = Clock::now();
     RenderResult more;
     renderer.RenderWithOneMore(source, &more);

@@ -42,8 +42,10 @@ class SourceLibrary {
   explicit SourceLibrary(ViewSetPaths paths);
   const std::vector<PosedCamera>& Cameras() const { return cameras_; }
   const std::vector<std::string>& Names() const { return names_; }
-  // Throws BadInputError naming the file for a missing or corrupt photo or depth map.
-  const SourceView& Load(int index);
+  // On first use marks the view's background for warps with `warp` (MarkSourceBackground),
+  // only when they warp background at infinity (--warp naive does not). Throws BadInputError
+  // naming the file for a missing or corrupt photo or depth map.
+  const SourceView& Load(int index, const ForwardWarpOptions& warp);
   int LoadedCount() const;
   // Runs on each view as it is loaded, before it is warped, to prepare its depth map (for a
   // workspace's estimated depth: specks out, holes from the mesh; see apps/render_options.h);
