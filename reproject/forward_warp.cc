@@ -248,11 +248,13 @@ class SourceWarper {
     for (int y = 0; y < height_; ++y) {
       for (int x = 0; x < width_;) {
         const size_t i = Index(x, y);
-        uint64_t eight = 0;
-        if (x + 8 <= width_) std::memcpy(&eight, edge + i, sizeof(eight));
-        if (x + 8 <= width_ && eight == 0) {
-          x += 8;
-          continue;
+        if (x + 8 <= width_) {
+          uint64_t eight;
+          std::memcpy(&eight, edge + i, sizeof(eight));
+          if (eight == 0) {
+            x += 8;
+            continue;
+          }
         }
         if (edge[i] != 0) SplatVertex(x, y);
         ++x;
