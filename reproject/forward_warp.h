@@ -72,7 +72,6 @@ class WarpBuffer {
   const float* Depths() const { return depth_.get(); }  // Size() of them.
   // Linear RGB of the sample; meaningful only where Depth(i) != 0.
   const float* Color(size_t i) const { return &color_[3 * i]; }
-  // Meaningful only where Depth(i) != 0.
   // The blend's weight of the sample (Unstructured-Lumigraph style), meaningful only where
   // Depth(i) != 0: 1 / ((angle + ForwardWarpOptions::angle_epsilon_rad) * max(1, stretch)),
   // where angle is that at the 3D point between the rays from the source and the target
