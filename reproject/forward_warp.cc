@@ -45,6 +45,7 @@ struct WarpScratch::Data {
   std::vector<size_t> stack;        // MarkBackground's flood fill.
   std::vector<uint8_t> edge;        // Mesh: per vertex, 1 when it is to be splatted.
   std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
+  std::vector<uint8_t> beside_dropped;  // Mesh: PenaliseSilhouetteRow's, one row.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
 };
 
@@ -210,6 +211,34 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices&
     for (int k = 0; k < n; ++k) quad[chunk + k] = p[k] & p[k + 1] & q[k] & q[k + 1] & keep[k];
   }
   quad[width - 1] = 0;
+}
+
+// Adds `penalty` to the ray angle (so to the blend weight's denominator) of the surface
+// vertices of source row y beside a dropped quad (quads: ContinuousRow's, complete): those
+// pixels lie on a silhouette, or next to sky or unknown depth, and their photo colour mixes
+// the two sides, where another source that sees the point away from its silhouettes has it
+// pure. Quads outside the image do not count (the image border is no silhouette).
+void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penalty, int y,
+                           uint8_t* beside_dropped_row, Vertices* vtx) {
+  const int width = s.src.width, height = s.src.height;
+  if (width < 2 || height < 2) return;  // No quads.
+  const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+  // Quad rows y - 1 and y; the first and the last vertex row have one of them, read twice
+  // (AND is idempotent). Quad column width - 1 does not exist (ContinuousRow marks it 0).
+  const uint8_t* __restrict above = y > 0 ? quads + row - static_cast<size_t>(width) : quads + row;
+  const uint8_t* __restrict below = y + 1 < height ? quads + row : above;
+  const uint8_t* __restrict kind = vtx->kind.get() + row;
+  uint8_t* __restrict beside_dropped = beside_dropped_row;
+  const int last = width - 1;
+  beside_dropped[0] = (above[0] & below[0]) != kSurface;
+  for (int x = 1; x < last; ++x) {
+    beside_dropped[x] = (above[x - 1] & above[x] & below[x - 1] & below[x]) != kSurface;
+  }
+  beside_dropped[last] = (above[last - 1] & below[last - 1]) != kSurface;
+  float* angle = vtx->angle.get() + row;
+  for (int x = 0; x < width; ++x) {
+    if (beside_dropped[x] != 0 && kind[x] == kSurface) angle[x] += penalty;
+  }
 }
 
 class SourceWarper {
@@ -452,6 +481,9 @@ void ForwardWarpOptions::Check() const {
   if (!(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad))) {
     fail("angle_epsilon_rad", angle_epsilon_rad, "> 0");
   }
+  if (!(silhouette_angle_rad >= 0 && std::isfinite(silhouette_angle_rad))) {
+    fail("silhouette_angle_rad", silhouette_angle_rad, ">= 0");
+  }
 }
 
 void WarpBuffer::Reset(int width, int height) {
@@ -541,6 +573,15 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
         ContinuousRow(source, setup, vertices, y, data.continuous.data());
       }
     });
+    const auto penalty = static_cast<float>(options.silhouette_angle_rad);
+    if (penalty > 0) {
+      // Serial: ~0.1 ms, and a nested parallel loop here slowed a K=4 render by more.
+      data.beside_dropped.resize(static_cast<size_t>(width));
+      for (int y = 0; y < height; ++y) {
+        PenaliseSilhouetteRow(setup, data.continuous.data(), penalty, y,
+                              data.beside_dropped.data(), &vertices);
+      }
+    }
     warper.Mesh(data.continuous, &data.edge);
   } else {
     warper.Splats();

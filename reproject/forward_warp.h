@@ -50,6 +50,12 @@ struct ForwardWarpOptions {
   // Added to the ray angle in the sample's blend weight (WarpBuffer::Weight), so a source that
   // sees the point exactly along the target ray gets a large, finite weight (radians, > 0).
   double angle_epsilon_rad = 0.01;
+  // Mesh: added to the ray angle of samples on a silhouette (a surface pixel beside a depth
+  // edge, sky or unknown depth; radians, >= 0): the photo mixes the two sides there, and a
+  // source that sees the point away from its silhouettes has its pure colour. 0.5 rad:
+  // courtyard novel views, ground-truth sources 31.99 -> 32.07 dB, estimated 28.17 -> 28.22
+  // (0.25 and 1 within 0.02 dB of it).
+  double silhouette_angle_rad = 0.5;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };

@@ -82,6 +82,54 @@ TEST(ForwardWarp, MeshDropsTrianglesAcrossDepthDiscontinuities) {
   EXPECT_EQ(intermediate, 0);
 }
 
+// Source pixels with an 8-neighbour across a depth step (the box's outline, on the box and on
+// the wall) against those farther from any: identity warp, so every target pixel holds its
+// own source pixel's sample, whose ray angle is 0. A block (up to 4 x 4 pixels) is drawn from
+// its corners: on its edges and inside, the penalty of a corner on the outline fades with the
+// distance from it, so an outline pixel midway along a block's edge has a quarter of it or
+// more, and pixels up to 4 from the outline some.
+TEST(ForwardWarp, SilhouetteSamplesWeighLess) {
+  const PosedCamera camera = CameraAt(TestCamera(), {0, 0, 0});
+  const SourceView source = test::RenderView(BoxScene(), camera);
+  const auto step_within = [&](int x, int y, int reach) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const int u = std::clamp(x + dx, 0, 159), v = std::clamp(y + dy, 0, 119);
+        if (std::abs(source.depth.At(u, v) - source.depth.At(x, y)) > 1) return true;
+      }
+    }
+    return false;
+  };
+  for (double penalty : {0.0, 0.5}) {
+    ForwardWarpOptions options;
+    options.silhouette_angle_rad = penalty;
+    WarpBuffer buffer;
+    ForwardWarp(source, camera, options, &buffer);
+    const double interior = 1 / options.angle_epsilon_rad;
+    const double silhouette = 1 / (options.angle_epsilon_rad + penalty);
+    int outline = 0;
+    for (int y = 0; y < 120; ++y) {
+      for (int x = 0; x < 160; ++x) {
+        const double weight = buffer.Weight(static_cast<size_t>(y * 160 + x));
+        if (step_within(x, y, 1)) {
+          ++outline;
+          const double quarter = 1 / (options.angle_epsilon_rad + penalty / 4);
+          EXPECT_TRUE(weight >= silhouette * 0.999 && weight <= quarter * 1.001) << weight;
+        } else if (!step_within(x, y, 4)) {
+          EXPECT_NEAR(weight, interior, 1e-3 * interior) << x << "," << y;
+        } else {
+          EXPECT_TRUE(weight >= silhouette * 0.999 && weight <= interior * 1.001) << weight;
+        }
+      }
+    }
+    // The box spans ~38 x 30 pixels: its outline, inside and out, ~2 x 136 pixels.
+    EXPECT_GT(outline, 250);
+  }
+  ForwardWarpOptions options;
+  options.silhouette_angle_rad = -0.1;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
 TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
   const Camera camera = TestCamera();
   const SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
