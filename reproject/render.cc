@@ -5,7 +5,9 @@
 #include <string>
 #include <utility>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 
 namespace parallax {
 namespace {
@@ -49,9 +51,18 @@ void Renderer::Render(const std::vector<const SourceView*>& sources, const Targe
   target_ = target;
   buffers_.resize(sources.size());
   scratch_.resize(sources.size());
-  tbb::parallel_for(size_t{0}, sources.size(), [&](size_t i) {
-    ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i]);
-  });
+  // One task per source, taken by whichever thread is free: the default partitioner splits
+  // four sources into two fixed pairs in selection order, and the best sources, which cover
+  // most of the target, cost the most (K=4: 640x480 29.5 -> 28.8 ms, 1920x1080 229 -> 220 ms,
+  // A/B medians of three rounds).
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, sources.size(), 1),
+      [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i < range.end(); ++i) {
+          ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i]);
+        }
+      },
+      tbb::simple_partitioner());
   Finish(start, MsSince(start), result);
 }
 
