@@ -82,10 +82,11 @@ class WarpBuffer {
   // Depth(i) != 0: 1 / ((angle + ForwardWarpOptions::angle_epsilon_rad) * max(1, stretch)),
   // where angle is that at the 3D point between the rays from the source and the target
   // centres, as the chord 2 sin(angle / 2) (within 1% below 28 degrees; 0 for background,
-  // whose rays are parallel), and stretch is target pixels per source pixel (area ratio; > 1
-  // where the source is magnified, sampled too sparsely for the target). One float computed
-  // by the warp rather than angle and stretch for the blend to combine: 4 bytes less per
-  // sample to write and read back (the K=4 render core 33.4 -> 31.8 ms).
+  // whose rays are parallel; plus ForwardWarpOptions::silhouette_angle_rad on the source's
+  // silhouettes, fading across a block), and stretch is target pixels per source pixel (area
+  // ratio; > 1 where the source is magnified, sampled too sparsely for the target). One
+  // float computed by the warp rather than angle and stretch for the blend to combine: 4
+  // bytes less per sample to write and read back (the K=4 render core 33.4 -> 31.8 ms).
   float Weight(size_t i) const { return weight_[i]; }
 
   float* MutableDepth() { return depth_.get(); }
