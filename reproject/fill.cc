@@ -154,6 +154,12 @@ class DepthAwareFiller {
     for (int k = 0; k < count_; ++k) {
       if (!March(x, y, dir_[static_cast<size_t>(k)], &candidates[static_cast<size_t>(found)])) continue;
       const float depth = candidates[static_cast<size_t>(found)].depth;
+      // Background is the farthest of all, and where it is taken the sky model alone gives the
+      // colour: the other directions cannot change the result.
+      if (!hidden_surface && std::isinf(depth) && sky_.Valid()) {
+        WriteBackground(x, y);
+        return true;
+      }
       farthest = std::max(farthest, depth);
       if (!std::isinf(depth)) farthest_surface = std::max(farthest_surface, depth);
       ++found;
@@ -171,13 +177,13 @@ class DepthAwareFiller {
       if (!background) depth += w * c.depth;
       weight += w;
     }
+    if (background && sky_.Valid()) {
+      WriteBackground(x, y);
+      return true;
+    }
     const size_t i = Index(x, y);
     float* out = blend_.color.Pixels().data() + 3 * i;
-    if (background && sky_.Valid()) {
-      sky_.ColorAt(x, y, out);
-    } else {
-      for (int ch = 0; ch < 3; ++ch) out[ch] = rgb[ch] / weight;
-    }
+    for (int ch = 0; ch < 3; ++ch) out[ch] = rgb[ch] / weight;
     blend_.depth.Values()[i] = background ? 0.0f : depth / weight;
     return true;
   }
@@ -185,6 +191,13 @@ class DepthAwareFiller {
  private:
   size_t Index(int x, int y) const {
     return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
+  }
+
+  // The sky model's colour at (x, y), with depth 0 (background at infinity).
+  void WriteBackground(int x, int y) {
+    const size_t i = Index(x, y);
+    sky_.ColorAt(x, y, blend_.color.Pixels().data() + 3 * i);
+    blend_.depth.Values()[i] = 0.0f;
   }
 
   bool March(int x, int y, const std::array<float, 2>& dir, Candidate* out) const {
