@@ -142,17 +142,46 @@ class DepthAwareFiller {
     MeasureDistances();
   }
 
+  // Per column of one row, the nearest column on either side with a sample (-1 and the width
+  // where there is none).
+  struct RowSamples {
+    std::vector<int> left, right;
+  };
+
+  // The marches along the row (directions 0 and pi) become one lookup each: an out-of-view
+  // band across the image left them to cross it pixel by pixel (the distance field lets no
+  // march along the band's edge jump), 40% of the fill of a view looking up.
+  void FindRowSamples(int y, RowSamples* row) const {
+    row->left.resize(static_cast<size_t>(width_));
+    row->right.resize(static_cast<size_t>(width_));
+    const SampleKind* kind = blend_.kind.data() + Index(0, y);
+    int nearest = -1;
+    for (int x = 0; x < width_; ++x) {
+      row->left[static_cast<size_t>(x)] = nearest;
+      if (kind[x] != SampleKind::kNone) nearest = x;
+    }
+    nearest = width_;
+    for (int x = width_ - 1; x >= 0; --x) {
+      row->right[static_cast<size_t>(x)] = nearest;
+      if (kind[x] != SampleKind::kNone) nearest = x;
+    }
+  }
+
   // Reads only pixels with samples and writes only the pixel itself (which has none), so rows
-  // can be filled in parallel in place.
+  // can be filled in parallel in place. `row`: FindRowSamples of row y.
   // `hidden_surface`: the pixel is a hole, where the ray reaches something the sources see
   // behind what is in front of it; background at infinity is taken only when no surface is
   // found (else sky next to a disoccluded wall top would win as "farthest").
-  bool FillPixel(int x, int y, bool hidden_surface) {
+  bool FillPixel(int x, int y, bool hidden_surface, const RowSamples& row) {
     std::array<Candidate, kMaxDirections> candidates;
     int found = 0;
     float farthest = 0, farthest_surface = 0;
     for (int k = 0; k < count_; ++k) {
-      if (!March(x, y, dir_[static_cast<size_t>(k)], &candidates[static_cast<size_t>(found)])) continue;
+      Candidate* candidate = &candidates[static_cast<size_t>(found)];
+      const bool hit = k == 0               ? InRow(x, y, row.right[static_cast<size_t>(x)], candidate)
+                       : 2 * k == count_ ? InRow(x, y, row.left[static_cast<size_t>(x)], candidate)
+                                         : March(x, y, dir_[static_cast<size_t>(k)], candidate);
+      if (!hit) continue;
       const float depth = candidates[static_cast<size_t>(found)].depth;
       // Background is the farthest of all, and where it is taken the sky model alone gives the
       // colour: the other directions cannot change the result.
@@ -219,12 +248,24 @@ class DepthAwareFiller {
         if (distance > 1) step += kBlock * distance - 5;
         continue;
       }
-      out->depth = kind == SampleKind::kBackground ? std::numeric_limits<float>::infinity()
-                                                   : blend_.depth.Values()[j];
-      out->distance_px = s;
-      out->rgb = blend_.color.Pixels().data() + 3 * j;
+      Take(j, s, out);
       return true;
     }
+  }
+
+  // The sample at `column` of row y as the candidate of a march along the row from x; false
+  // outside the image (FindRowSamples found none).
+  bool InRow(int x, int y, int column, Candidate* out) const {
+    if (column < 0 || column >= width_) return false;
+    Take(Index(column, y), static_cast<float>(std::abs(column - x)), out);
+    return true;
+  }
+
+  void Take(size_t j, float distance_px, Candidate* out) const {
+    out->depth = blend_.kind[j] == SampleKind::kBackground ? std::numeric_limits<float>::infinity()
+                                                           : blend_.depth.Values()[j];
+    out->distance_px = distance_px;
+    out->rgb = blend_.color.Pixels().data() + 3 * j;
   }
 
   size_t BlockIndex(int bx, int by) const {
@@ -288,11 +329,12 @@ int FillDepthAware(const ClassMap& classes, const Pinhole& camera, const FillOpt
   DepthAwareFiller filler(options, sky, blend);
   std::vector<int> filled_per_row(static_cast<size_t>(classes.height), 0);
   tbb::parallel_for(0, classes.height, [&](int y) {
+    DepthAwareFiller::RowSamples row;  // Found at the row's first pixel to fill.
     for (int x = 0; x < classes.width; ++x) {
       const PixelClass pixel_class = classes.At(x, y);
-      if (ShouldFill(pixel_class, options) && filler.FillPixel(x, y, IsHole(pixel_class))) {
-        ++filled_per_row[static_cast<size_t>(y)];
-      }
+      if (!ShouldFill(pixel_class, options)) continue;
+      if (row.left.empty()) filler.FindRowSamples(y, &row);
+      if (filler.FillPixel(x, y, IsHole(pixel_class), row)) ++filled_per_row[static_cast<size_t>(y)];
     }
   });
   int filled = 0;
