@@ -97,6 +97,35 @@ TEST(FillHoles, OutOfViewIsLeftWhenAsked) {
   EXPECT_NEAR(result.fill.hole_ratio_filled, result.metrics.out_of_view_ratio, 1e-12);
 }
 
+// One row holds two samples, at its two ends, and nothing else anywhere: only the marches
+// along the row find them (as a lookup of the row's nearest samples, not a walk), and each
+// counts with 1 / its distance. Both at one depth, so both are blended.
+TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
+  constexpr int kWidth = 40, kHeight = 9, kRow = 4;
+  BlendResult blend;
+  blend.color.Reset(kWidth, kHeight, 3);
+  blend.depth.Reset(kWidth, kHeight);
+  blend.kind.assign(kWidth * kHeight, SampleKind::kNone);
+  ClassMap classes{kWidth, kHeight, std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion)};
+  for (int x : {0, kWidth - 1}) {
+    const size_t i = static_cast<size_t>(kRow * kWidth + x);
+    const Eigen::Vector3f& colour = x == 0 ? kBoxRed : kWallBlue;
+    for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = colour(ch);
+    blend.depth.Values()[i] = 3;
+    blend.kind[i] = SampleKind::kSurface;
+    classes.classes[i] = PixelClass::kCovered;
+  }
+  const FillSummary summary =
+      FillHoles(classes, MakePinholeCamera(1, kWidth, kHeight, 40, 40, 20, 4.5), {}, &blend);
+  // Pixel 20 of the row is 20 from the red sample and 19 from the blue one; beside either end
+  // the diagonal marches reach it too, and in the other rows no march finds anything.
+  const float red = 1.0f / 20, blue = 1.0f / 19;
+  const Eigen::Vector3f expected = (red * kBoxRed + blue * kWallBlue) / (red + blue);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(blend.color.At(20, kRow, ch), expected(ch), 1e-5);
+  EXPECT_NEAR(blend.depth.At(20, kRow), 3, 1e-5);
+  EXPECT_GE(summary.filled_px, kWidth - 2);
+}
+
 // A sky whose colour is affine in the direction (y is down: bluer upwards), seen by a source
 // looking level and rendered by a target pitched 12 degrees up: the target's top rows are
 // sky no source saw.
