@@ -178,11 +178,8 @@ class DepthAwareFiller {
     float farthest = 0, farthest_surface = 0;
     for (int k = 0; k < count_; ++k) {
       Candidate* candidate = &candidates[static_cast<size_t>(found)];
-      const bool hit = k == 0               ? InRow(x, y, row.right[static_cast<size_t>(x)], candidate)
-                       : 2 * k == count_ ? InRow(x, y, row.left[static_cast<size_t>(x)], candidate)
-                                         : March(x, y, dir_[static_cast<size_t>(k)], candidate);
-      if (!hit) continue;
-      const float depth = candidates[static_cast<size_t>(found)].depth;
+      if (!Find(k, x, y, row, candidate)) continue;
+      const float depth = candidate->depth;
       // Background is the farthest of all, and where it is taken the sky model alone gives the
       // colour: the other directions cannot change the result.
       if (!hidden_surface && std::isinf(depth) && sky_.Valid()) {
@@ -227,6 +224,15 @@ class DepthAwareFiller {
     const size_t i = Index(x, y);
     sky_.ColorAt(x, y, blend_.color.Pixels().data() + 3 * i);
     blend_.depth.Values()[i] = 0.0f;
+  }
+
+  // The nearest sample from (x, y) in direction k: along the row (k = 0 and the opposite one)
+  // looked up in `row`, else marched to.
+  bool Find(int k, int x, int y, const RowSamples& row, Candidate* out) const {
+    const size_t column = static_cast<size_t>(x);
+    if (k == 0) return InRow(x, y, row.right[column], out);
+    if (2 * k == count_) return InRow(x, y, row.left[column], out);
+    return March(x, y, dir_[static_cast<size_t>(k)], out);
   }
 
   bool March(int x, int y, const std::array<float, 2>& dir, Candidate* out) const {
@@ -334,7 +340,9 @@ int FillDepthAware(const ClassMap& classes, const Pinhole& camera, const FillOpt
       const PixelClass pixel_class = classes.At(x, y);
       if (!ShouldFill(pixel_class, options)) continue;
       if (row.left.empty()) filler.FindRowSamples(y, &row);
-      if (filler.FillPixel(x, y, IsHole(pixel_class), row)) ++filled_per_row[static_cast<size_t>(y)];
+      if (filler.FillPixel(x, y, IsHole(pixel_class), row)) {
+        ++filled_per_row[static_cast<size_t>(y)];
+      }
     }
   });
   int filled = 0;

@@ -106,7 +106,8 @@ TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
   blend.color.Reset(kWidth, kHeight, 3);
   blend.depth.Reset(kWidth, kHeight);
   blend.kind.assign(kWidth * kHeight, SampleKind::kNone);
-  ClassMap classes{kWidth, kHeight, std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion)};
+  ClassMap classes{kWidth, kHeight,
+                   std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion)};
   for (int x : {0, kWidth - 1}) {
     const size_t i = static_cast<size_t>(kRow * kWidth + x);
     const Eigen::Vector3f& colour = x == 0 ? kBoxRed : kWallBlue;
