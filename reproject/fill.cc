@@ -181,7 +181,8 @@ class DepthAwareFiller {
       if (!Find(k, x, y, row, candidate)) continue;
       const float depth = candidate->depth;
       // Background is the farthest of all, and where it is taken the sky model alone gives the
-      // colour: the other directions cannot change the result.
+      // colour: the other directions cannot change the result (a hole marches on: any surface
+      // it finds comes first).
       if (!hidden_surface && std::isinf(depth) && sky_.Valid()) {
         WriteBackground(x, y);
         return true;
@@ -254,7 +255,7 @@ class DepthAwareFiller {
         if (distance > 1) step += kBlock * distance - 5;
         continue;
       }
-      Take(j, s, out);
+      CandidateAt(j, s, out);
       return true;
     }
   }
@@ -263,11 +264,12 @@ class DepthAwareFiller {
   // outside the image (FindRowSamples found none).
   bool InRow(int x, int y, int column, Candidate* out) const {
     if (column < 0 || column >= width_) return false;
-    Take(Index(column, y), static_cast<float>(std::abs(column - x)), out);
+    CandidateAt(Index(column, y), static_cast<float>(std::abs(column - x)), out);
     return true;
   }
 
-  void Take(size_t j, float distance_px, Candidate* out) const {
+  // Sample j, distance_px from the pixel being filled.
+  void CandidateAt(size_t j, float distance_px, Candidate* out) const {
     out->depth = blend_.kind[j] == SampleKind::kBackground ? std::numeric_limits<float>::infinity()
                                                            : blend_.depth.Values()[j];
     out->distance_px = distance_px;
