@@ -75,7 +75,7 @@ WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& wor
 void AddRenderOptions(CLI::App& command, NovelViewSettings& settings) {
   command.add_option("--edge-erosion", settings.edge_erosion_px,
                      "workspace sources: drop this many pixels of estimated depth on the near side "
-                     "of every depth edge, where stereo fattens occluders (default 2; 0 keeps them)")
+                     "of every depth edge, where stereo fattens occluders (default 1; 0 keeps them)")
       ->check(CLI::Range(0, 8));
   command.add_option("--depth-holes", settings.depth_holes,
                      "workspace sources: fill the pixels their depth maps have no depth for from "

@@ -23,7 +23,7 @@ struct NovelViewSettings {
   std::string depth_holes = "mesh";
   // --edge-erosion: a workspace's depth pixels this close to a farther neighbour, on the near
   // side, are dropped (ErodeDepthEdges); 0 keeps them.
-  int edge_erosion_px = 2;
+  int edge_erosion_px = 1;
   // Applies `warp` to `render`; call before using the settings.
   void Resolve();
 };

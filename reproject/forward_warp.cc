@@ -290,13 +290,15 @@ class SourceWarper {
     }
     // In row-major order: z-test ties go the same way on every run.
     for (int y = 0; y < height_; ++y) {
-      ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y); });
+      ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) {
+        SplatVertex(x, y, OutlineShare(x, y));
+      });
     }
   }
 
   void Splats() {
     for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) SplatVertex(x, y);
+      for (int x = 0; x < width_; ++x) SplatVertex(x, y, 1.0f);
     }
   }
 
@@ -432,7 +434,36 @@ class SourceWarper {
     return false;
   }
 
-  void SplatVertex(int x, int y) {
+  // The share of its footprint a vertex is splatted with: outline_splat_share on the near
+  // side of an outline (a surface sample with a farther surface, sky or unknown depth among
+  // its eight neighbours inside the image), and what that gives up added on the far side (a
+  // sample with a nearer surface among them), so that the two still meet: the outline moves
+  // towards the near side, no crack opens. 1 elsewhere.
+  float OutlineShare(int x, int y) const {
+    const size_t i = Index(x, y);
+    const bool surface = vtx_.kind[i] == kSurface;
+    const float depth = SourceDepth(i);
+    bool near_side = false, far_side = false;
+    for (int ny = std::max(0, y - 1); ny <= std::min(height_ - 1, y + 1); ++ny) {
+      for (int nx = std::max(0, x - 1); nx <= std::min(width_ - 1, x + 1); ++nx) {
+        const size_t j = Index(nx, ny);
+        const bool neighbour_surface = vtx_.kind[j] == kSurface;
+        if (surface) {
+          near_side |= !neighbour_surface || SourceDepth(j) > s_.max_depth_ratio * depth;
+          far_side |= neighbour_surface && depth > s_.max_depth_ratio * SourceDepth(j);
+        } else {
+          far_side |= neighbour_surface;  // Sky (or unknown) beside a surface.
+        }
+      }
+    }
+    // Both: a step of a steep slope (or a thin sliver), where the outline is no edge.
+    if (near_side == far_side) return 1.0f;
+    const auto share = static_cast<float>(options_.outline_splat_share);
+    return near_side ? share : 2.0f - share;
+  }
+
+  // Splats the vertex with `share` of its footprint (its magnification, with overlap).
+  void SplatVertex(int x, int y, float share) {
     const size_t i = Index(x, y);
     if (vtx_.kind[i] == kInvalid) return;
     const bool background = vtx_.kind[i] == kSky;
@@ -448,7 +479,8 @@ class SourceWarper {
     const float extent_v = std::clamp(overlap * (std::abs(du[1]) + std::abs(dv[1])), 1.0f, max_px);
     float stretch = std::abs(du[0] * dv[1] - du[1] * dv[0]);
     if (!Finite(stretch)) stretch = max_px * max_px;
-    raster_->Splat(CornerAt({i, x, y}), 0.5f * extent_u, 0.5f * extent_v, stretch, background);
+    raster_->Splat(CornerAt({i, x, y}), 0.5f * share * extent_u, 0.5f * share * extent_v, stretch,
+                   background);
   }
 
   const SourceView& source_;
@@ -486,6 +518,9 @@ void ForwardWarpOptions::Check() const {
   }
   if (!(silhouette_angle_rad >= 0 && std::isfinite(silhouette_angle_rad))) {
     fail("silhouette_angle_rad", silhouette_angle_rad, ">= 0");
+  }
+  if (!(outline_splat_share > 0 && outline_splat_share <= 1)) {
+    fail("outline_splat_share", outline_splat_share, "(0, 1]");
   }
 }
 

@@ -130,6 +130,39 @@ TEST(ForwardWarp, SilhouetteSamplesWeighLess) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
+// The box's front face (z 4) spans source columns 61.25..98.75 and rows 45..75 (pixel
+// coordinates); the target is the source camera with its principal point half a pixel to the
+// right, so the face's outline falls halfway between target pixel centres: 37 columns (62 to
+// 98) x 30 rows have their centres on it. The mesh reaches the outermost samples, now 0.5
+// pixel short of a centre on either side; their full footprint (0.55 pixel either way) takes
+// one more column on each side, a share of 0.6 does not, and the wall's samples beside the
+// outline (1.4 of theirs) cover those columns: no hole opens.
+TEST(ForwardWarp, OutlineSamplesSplatAShareOfTheirFootprint) {
+  const SourceView source = test::RenderView(BoxScene(), CameraAt(TestCamera(), {0, 0, 0}));
+  const PosedCamera target =
+      CameraAt(MakePinholeCamera(1, 160, 120, 150, 150, 80.5, 60), {0, 0, 0});
+  const auto front_face_pixels = [&](double share) {
+    ForwardWarpOptions options;
+    options.outline_splat_share = share;
+    WarpBuffer buffer;
+    ForwardWarp(source, target, options, &buffer);
+    int count = 0, holes = 0;
+    for (size_t i = 0; i < buffer.Size(); ++i) {
+      count += std::abs(buffer.Depth(i) - 4.0f) < 0.01f ? 1 : 0;
+      holes += buffer.Depth(i) == 0 ? 1 : 0;
+    }
+    EXPECT_EQ(holes, 0) << share;
+    return count;
+  };
+  EXPECT_EQ(front_face_pixels(0.6), 37 * 30);
+  EXPECT_EQ(front_face_pixels(1.0), 39 * 30);
+  ForwardWarpOptions options;
+  options.outline_splat_share = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+  options.outline_splat_share = 1.5;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
+}
+
 TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
   const Camera camera = TestCamera();
   const SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
