@@ -133,13 +133,25 @@ class DepthAwareFiller {
  public:
   DepthAwareFiller(const FillOptions& options, const SkyModel& sky, BlendResult* blend)
       : blend_(*blend), sky_(sky), width_(blend->color.Width()), height_(blend->color.Height()),
-        count_(options.directions), tolerance_(static_cast<float>(options.background_tolerance)) {
+        count_(options.directions), tolerance_(static_cast<float>(options.background_tolerance)),
+        hole_sky_directions_(static_cast<int>(std::ceil(options.hole_sky_share * count_))) {
     for (int k = 0; k < count_; ++k) {
       const double angle = 2 * kPi * k / count_;
       dir_[static_cast<size_t>(k)] = {static_cast<float>(std::cos(angle)),
                                       static_cast<float>(std::sin(angle))};
     }
     MeasureDistances();
+  }
+
+  // How many directions must find background at infinity for it to be the background side of
+  // a pixel of class c: one out of view (background is the farthest of all); for a hole,
+  // where the ray reaches something the sources see behind what is in front of it,
+  // hole_sky_share of them where it is open to the sky, else more than there are (background
+  // only where no surface is found: sky next to a disoccluded wall top would win as
+  // "farthest").
+  int SkyDirections(PixelClass c, bool open_to_sky) const {
+    if (!IsHole(c)) return 1;
+    return open_to_sky ? hole_sky_directions_ : count_ + 1;
   }
 
   // Per column of one row, the nearest column on either side with a sample (-1 and the width
@@ -168,31 +180,31 @@ class DepthAwareFiller {
   }
 
   // Reads only pixels with samples and writes only the pixel itself (which has none), so rows
-  // can be filled in parallel in place. `row`: FindRowSamples of row y.
-  // `hidden_surface`: the pixel is a hole, where the ray reaches something the sources see
-  // behind what is in front of it; background at infinity is taken only when no surface is
-  // found (else sky next to a disoccluded wall top would win as "farthest").
-  bool FillPixel(int x, int y, bool hidden_surface, const RowSamples& row) {
+  // can be filled in parallel in place. `row`: FindRowSamples of row y. Background at
+  // infinity is the background side once `sky_directions` directions find it (SkyDirections).
+  bool FillPixel(int x, int y, int sky_directions, const RowSamples& row) {
     std::array<Candidate, kMaxDirections> candidates;
-    int found = 0;
+    int found = 0, skies = 0;
     float farthest = 0, farthest_surface = 0;
     for (int k = 0; k < count_; ++k) {
       Candidate* candidate = &candidates[static_cast<size_t>(found)];
       if (!Find(k, x, y, row, candidate)) continue;
       const float depth = candidate->depth;
-      // Background is the farthest of all, and where it is taken the sky model alone gives the
-      // colour: the other directions cannot change the result (a hole marches on: any surface
-      // it finds comes first).
-      if (!hidden_surface && std::isinf(depth) && sky_.Valid()) {
-        WriteBackground(x, y);
-        return true;
+      if (std::isinf(depth)) {
+        // Background is the farthest of all, and where it is taken the sky model alone gives
+        // the colour: the other directions cannot change the result.
+        if (++skies >= sky_directions && sky_.Valid()) {
+          WriteBackground(x, y);
+          return true;
+        }
+      } else {
+        farthest_surface = std::max(farthest_surface, depth);
       }
       farthest = std::max(farthest, depth);
-      if (!std::isinf(depth)) farthest_surface = std::max(farthest_surface, depth);
       ++found;
     }
     if (found == 0) return false;
-    if (hidden_surface && farthest_surface > 0) farthest = farthest_surface;
+    if (skies < sky_directions && farthest_surface > 0) farthest = farthest_surface;
     const bool background = std::isinf(farthest);
     const float limit = background ? farthest : farthest * (1.0f - tolerance_);
     float rgb[3] = {0, 0, 0}, depth = 0, weight = 0;
@@ -326,6 +338,7 @@ class DepthAwareFiller {
   int height_;
   int count_;
   float tolerance_;
+  int hole_sky_directions_;
   std::array<std::array<float, 2>, kMaxDirections> dir_{};
   int blocks_x_ = 0;
   std::vector<uint16_t> distance_;
@@ -342,7 +355,8 @@ int FillDepthAware(const ClassMap& classes, const Pinhole& camera, const FillOpt
       const PixelClass pixel_class = classes.At(x, y);
       if (!ShouldFill(pixel_class, options)) continue;
       if (row.left.empty()) filler.FindRowSamples(y, &row);
-      if (filler.FillPixel(x, y, IsHole(pixel_class), row)) {
+      const int sky_directions = filler.SkyDirections(pixel_class, classes.OpenToSky(x, y));
+      if (filler.FillPixel(x, y, sky_directions, row)) {
         ++filled_per_row[static_cast<size_t>(y)];
       }
     }
@@ -394,6 +408,10 @@ void FillOptions::Check() const {
   if (!(background_tolerance > 0 && background_tolerance < 1)) {
     throw std::invalid_argument("FillOptions.background_tolerance = " +
                                 std::to_string(background_tolerance) + ": expected (0, 1)");
+  }
+  if (!(hole_sky_share > 0 && hole_sky_share <= 1)) {
+    throw std::invalid_argument("FillOptions.hole_sky_share = " + std::to_string(hole_sky_share) +
+                                ": expected (0, 1]");
   }
   if (!(inpaint_radius_px > 0 && std::isfinite(inpaint_radius_px))) {
     throw std::invalid_argument("FillOptions.inpaint_radius_px = " +

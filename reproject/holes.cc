@@ -126,6 +126,19 @@ bool RayIsHole(const std::vector<SourceFrustum>& sources, const std::vector<Eige
   return false;
 }
 
+// Whether the sky may lie behind what the sources saw in the ray's direction: no source that
+// contains the direction saw it without knowing its depth (depth 0 that is not background,
+// such as ground whose estimate failed: a surface, not sky).
+bool OpenToSky(const std::vector<SourceFrustum>& sources, const std::vector<Eigen::Vector3d>& dirs,
+               const HoleOptions& options) {
+  for (size_t j = 0; j < sources.size(); ++j) {
+    if (ViewOfPoint(sources[j], dirs[j], 0, options.free_space_tolerance) == PointView::kUnknown) {
+      return false;
+    }
+  }
+  return true;
+}
+
 std::vector<DepthRange> RowDepthRanges(const BlendResult& blend) {
   const int width = blend.color.Width(), height = blend.color.Height();
   std::vector<DepthRange> rows(static_cast<size_t>(height));
@@ -249,7 +262,8 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
   for (const DepthRange& row : rows) global.Merge(row);
   const double inv_nearest = global.HasSurface() ? 1 / global.near : 0;
 
-  ClassMap map{width, height, std::vector<PixelClass>(blend.kind.size())};
+  ClassMap map{width, height, std::vector<PixelClass>(blend.kind.size()), {}};
+  if (all_depth) map.open_to_sky.assign(blend.kind.size(), 0);
   std::vector<uint8_t> hole(blend.kind.size(), 0);
   tbb::parallel_for(0, height, [&](int y) {
     DepthRange range;
@@ -290,6 +304,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
       }
       map.classes[i] = in_view ? PixelClass::kDisocclusion : PixelClass::kOutOfView;
       hole[i] = in_view ? 1 : 0;
+      if (in_view && all_depth) map.open_to_sky[i] = OpenToSky(frustums, dirs, options) ? 1 : 0;
     }
   });
 

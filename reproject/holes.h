@@ -42,9 +42,17 @@ struct ClassMap {
   int width = 0;
   int height = 0;
   std::vector<PixelClass> classes;  // Row-major.
+  // Row-major, 1 for a hole pixel whose direction no source saw without knowing its depth:
+  // each source looking that way saw a surface (or nothing), and the sky may lie behind it.
+  // Empty where that is not known (some source without depth): no hole is open to the sky.
+  std::vector<uint8_t> open_to_sky;
 
-  PixelClass At(int x, int y) const {
-    return classes[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)];
+  PixelClass At(int x, int y) const { return classes[Index(x, y)]; }
+  bool OpenToSky(int x, int y) const { return !open_to_sky.empty() && open_to_sky[Index(x, y)] != 0; }
+
+ private:
+  size_t Index(int x, int y) const {
+    return static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
   }
 };
 
@@ -81,7 +89,8 @@ struct ClassifySource {
 //    sources' depth maps: when every point is outside all sources or seen as empty space by
 //    one of them, no source saw anything on the ray, so it is out of view too (a target
 //    looking above the sources sees sky nobody photographed, not a hole);
-//  - else it is a hole: a crack when thin, else a disocclusion.
+//  - else it is a hole: a crack when thin, else a disocclusion; open to the sky unless some
+//    source that contains its direction has depth 0 (not background) there.
 // Throws std::invalid_argument for a non-pinhole camera, a size mismatch between blend and
 // target or between a source's camera and its depth map, or bad options.
 ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,

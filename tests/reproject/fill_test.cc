@@ -107,7 +107,7 @@ TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
   blend.depth.Reset(kWidth, kHeight);
   blend.kind.assign(kWidth * kHeight, SampleKind::kNone);
   ClassMap classes{kWidth, kHeight,
-                   std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion)};
+                   std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion), {}};
   for (int x : {0, kWidth - 1}) {
     const size_t i = static_cast<size_t>(kRow * kWidth + x);
     const Eigen::Vector3f& colour = x == 0 ? kBoxRed : kWallBlue;
@@ -125,6 +125,57 @@ TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
   for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(blend.color.At(20, kRow, ch), expected(ch), 1e-5);
   EXPECT_NEAR(blend.depth.At(20, kRow), 3, 1e-5);
   EXPECT_GE(summary.filled_px, kWidth - 2);
+}
+
+// Sky above row 30, ground (blue, depth 5) below, and a 10 x 10 hole just above the ground:
+// from its pixels the nine directions up and along the row find sky, the seven down find
+// ground. Open to the sky, half the directions suffice for the sky; not open (or with all
+// directions asked for), the hole takes the ground, as any hole beside a surface did before.
+TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
+  constexpr int kSize = 40, kGround = 30;
+  const Eigen::Vector3f sky(0.5f, 0.6f, 0.9f);
+  const auto fill = [&](bool open_to_sky, double share) {
+    BlendResult blend;
+    blend.color.Reset(kSize, kSize, 3);
+    blend.depth.Reset(kSize, kSize);
+    blend.kind.assign(kSize * kSize, SampleKind::kNone);
+    ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kCovered),
+                     std::vector<uint8_t>(kSize * kSize, open_to_sky ? 1 : 0)};
+    for (int y = 0; y < kSize; ++y) {
+      for (int x = 0; x < kSize; ++x) {
+        const size_t i = static_cast<size_t>(y * kSize + x);
+        if (x >= 15 && x < 25 && y >= 20 && y < kGround) {
+          classes.classes[i] = PixelClass::kDisocclusion;
+          continue;
+        }
+        const bool ground = y >= kGround;
+        const Eigen::Vector3f& colour = ground ? kWallBlue : sky;
+        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = colour(ch);
+        blend.depth.Values()[i] = ground ? 5.0f : 0.0f;
+        blend.kind[i] = ground ? SampleKind::kSurface : SampleKind::kBackground;
+        classes.classes[i] = ground ? PixelClass::kCovered : PixelClass::kBackground;
+      }
+    }
+    FillOptions options;
+    options.hole_sky_share = share;
+    FillHoles(classes, MakePinholeCamera(1, kSize, kSize, 40, 40, 20, 20), options, &blend);
+    return blend;
+  };
+  const BlendResult open = fill(true, 0.5), closed = fill(false, 0.5), all = fill(true, 1.0);
+  for (int y = 20; y < kGround; ++y) {
+    for (int x = 15; x < 25; ++x) {
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(open.color.At(x, y, ch), sky(ch), 1e-4) << x << "," << y;
+        EXPECT_NEAR(closed.color.At(x, y, ch), kWallBlue(ch), 1e-5) << x << "," << y;
+        EXPECT_NEAR(all.color.At(x, y, ch), kWallBlue(ch), 1e-5) << x << "," << y;
+      }
+      EXPECT_EQ(open.depth.At(x, y), 0);
+      EXPECT_NEAR(closed.depth.At(x, y), 5, 1e-5);
+    }
+  }
+  FillOptions options;
+  options.hole_sky_share = 0;
+  EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
 // A sky whose colour is affine in the direction (y is down: bluer upwards), seen by a source

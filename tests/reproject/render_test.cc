@@ -123,6 +123,40 @@ TEST(Render, BoxInFrontOfWallDisocclusionMatchesRayCasting) {
   }
 }
 
+// The sky may lie behind what the source saw in a hole's direction, not where it saw
+// something there without knowing its depth. Target and source differ by a translation only,
+// so the direction of target pixel (x, y) is source pixel (x, y). As rendered, every
+// disocclusion looks at the box in the source (open); with the box's depth removed, the holes
+// whose direction falls on it are not open, the others are.
+TEST(Render, HolesAreOpenToTheSkyUnlessTheSourceSawTheirDirectionWithoutDepth) {
+  SourceView source = test::RenderView(BoxScene(), CameraAt(BoxCamera(), {0, 0, 0}));
+  const PosedCamera target = CameraAt(BoxCamera(), {0.8, 0, 0});
+  RenderOptions options = Options(WarpMethod::kMesh);
+  options.warp.background_at_infinity = false;
+  // Hole pixels, and those of them whose source pixel has no depth.
+  const auto count_holes = [&](long* closed) {
+    const RenderResult result = Render({&source}, target, options);
+    long holes = 0;
+    *closed = 0;
+    for (int y = 0; y < 300; ++y) {
+      for (int x = 0; x < 400; ++x) {
+        if (!IsHole(result.classes.At(x, y))) continue;
+        ++holes;
+        const bool unknown = source.depth.At(x, y) == 0;
+        EXPECT_EQ(result.classes.OpenToSky(x, y), !unknown) << x << "," << y;
+        *closed += unknown ? 1 : 0;
+      }
+    }
+    return holes;
+  };
+  long closed = 0;
+  EXPECT_GT(count_holes(&closed), 5000);
+  EXPECT_EQ(closed, 0);
+  for (float& depth : source.depth.Values()) depth = depth < 6 ? 0.0f : depth;
+  EXPECT_GT(count_holes(&closed), 5000);
+  EXPECT_GT(closed, 5000);
+}
+
 TEST(Render, PureRotationHasNoDisocclusion) {
   const Scene scene = BoxScene();
   const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
