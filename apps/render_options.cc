@@ -87,8 +87,8 @@ void AddRenderOptions(CLI::App& command, NovelViewSettings& settings) {
       ->check(CLI::Range(1, 64));
   command.add_option("--hole-sources", settings.selection.hole_sources,
                      "at most this many more source views per novel view, added one at a time "
-                     "while holes remain, each the one that sees most of what they hide "
-                     "(default 2; 0: only the --sources best)")
+                     "while holes or surfaces out of view remain, each the one that sees most of "
+                     "them (default 2; 0: only the --sources best)")
       ->check(CLI::Range(0, 16));
   command.add_option("--warp", settings.warp,
                      "forward warp: mesh (default; triangles, dropped across depth edges), splat "

@@ -214,24 +214,39 @@ int SourceLibrary::LoadedCount() const {
 
 namespace {
 
-// Hole pixels are rendered again with one more source only while they make up this share of
-// the image: below it, another warp costs more than the few pixels it could fix.
-constexpr double kMinHoleRatioForMoreSources = 0.001;
-// A source is added only when at least this many of the sampled hole points lie in its frame.
-constexpr int kMinHolePointsInFrame = 32;
-// An added source must leave at most this share of the holes.
-constexpr double kKeptHoleShare = 0.9;
+// A view is rendered again with one more source only while its unseen pixels make up this
+// share of the image: below it, another warp costs more than the few pixels it could fix.
+constexpr double kMinUnseenRatioForMoreSources = 0.001;
+// A source is added only when at least this many of the sampled unseen points lie in its frame.
+constexpr int kMinUnseenPointsInFrame = 32;
+// An added source must leave at most this share of the unseen pixels.
+constexpr double kKeptUnseenShare = 0.9;
+
+// Share of the image's pixels that are Unseen.
+double UnseenRatio(const RenderResult& result) {
+  long count = 0;
+  for (int y = 0; y < result.classes.height; ++y) {
+    for (int x = 0; x < result.classes.width; ++x) count += Unseen(result, x, y) ? 1 : 0;
+  }
+  const auto pixels = static_cast<double>(result.classes.classes.size());
+  return pixels > 0 ? static_cast<double>(count) / pixels : 0.0;
+}
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedCamera& target) {
+bool Unseen(const RenderResult& result, int x, int y) {
+  const PixelClass c = result.classes.At(x, y);
+  return IsHole(c) || (c == PixelClass::kOutOfView && result.depth.At(x, y) > 0);
+}
+
+std::vector<Eigen::Vector3d> UnseenPoints(const RenderResult& result, const PosedCamera& target) {
   const Pinhole camera = Pinhole::From(target.camera);
   const Rigid3d world_from_cam = target.cam_from_world.Inverse();
   std::vector<Eigen::Vector3d> points;
   for (int y = 0; y < result.classes.height; y += 2) {
     for (int x = 0; x < result.classes.width; x += 2) {
       const float depth = result.depth.At(x, y);
-      if (!IsHole(result.classes.At(x, y)) || !(depth > 0) || !std::isfinite(depth)) continue;
+      if (!Unseen(result, x, y) || !(depth > 0) || !std::isfinite(depth)) continue;
       points.push_back(world_from_cam * (camera.PixelRay(x, y) * static_cast<double>(depth)));
     }
   }
@@ -255,15 +270,16 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   auto render_start = Clock::now();
   renderer.Render(sources, target.camera, &view->result);
   spent += Clock::now() - render_start;
-  // More sources, one at a time, while holes remain and some source sees into them.
+  // More sources, one at a time, while unseen pixels remain and some source sees them.
   const int hole_sources =
       renderer.Options().fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
+  double unseen = hole_sources > 0 ? UnseenRatio(view->result) : 0.0;
   for (int extra = 0; extra < hole_sources; ++extra) {
-    if (view->result.metrics.hole_ratio < kMinHoleRatioForMoreSources) break;
+    if (unseen < kMinUnseenRatioForMoreSources) break;
     const auto pick_start = Clock::now();
     const int pick = SourceSeeingMost(library.Cameras(), target.camera,
-                                      HolePoints(view->result, target.camera), chosen,
-                                      kMinHolePointsInFrame, selection);
+                                      UnseenPoints(view->result, target.camera), chosen,
+                                      kMinUnseenPointsInFrame, selection);
     spent += Clock::now() - pick_start;
     if (pick < 0) break;
     const SourceView& source = library.Load(pick, warp);
@@ -271,11 +287,13 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     RenderResult more;
     renderer.RenderWithOneMore(source, &more);
     spent += Clock::now() - render_start;
-    // Kept only when it closes a tenth of the holes at least: else it did not see into them
-    // after all (occluded as well), and the render without it stands.
-    if (!(more.metrics.hole_ratio < kKeptHoleShare * view->result.metrics.hole_ratio)) break;
+    // Kept only when it shows a tenth of the unseen pixels at least: else it did not see
+    // them after all (occluded as well), and the render without it stands.
+    const double unseen_after = UnseenRatio(more);
+    if (!(unseen_after < kKeptUnseenShare * unseen)) break;
     chosen.push_back(pick);
     view->result = std::move(more);
+    unseen = unseen_after;
   }
   for (int index : chosen) view->sources.push_back(library.Names()[static_cast<size_t>(index)]);
   // Selection and rendering; reading files is left out (the first targets pay for all).

@@ -75,18 +75,24 @@ struct NovelView {
   double ms = 0;                     // Selection, warping, blending, classification, filling.
 };
 
-// World points of a render's hole pixels (every other pixel of every other row) at the depth
-// the fill gave them: the background side of each hole, what the sources did not see.
-std::vector<Eigen::Vector3d> HolePoints(const RenderResult& result, const PosedCamera& target);
+// Whether pixel (x, y) of a render is one no source saw that another source might show: a
+// hole, or an out-of-view pixel the fill continued a surface into (not sky, which looks the
+// same from anywhere). Needs the depth the depth-aware fill gives them.
+bool Unseen(const RenderResult& result, int x, int y);
+
+// World points of a render's Unseen pixels (every other pixel of every other row) at the
+// depth the fill gave them: the background side of each hole and the surfaces continued past
+// the sources' frames, what the sources did not see.
+std::vector<Eigen::Vector3d> UnseenPoints(const RenderResult& result, const PosedCamera& target);
 
 // Selects up to `selection.num_sources` sources for `target`, loads them, renders; then, while
-// holes cover 0.1% of the image or more, adds up to `selection.hole_sources` more, one at a
-// time, each the source that sees most of HolePoints (SourceSeeingMost); it stops at the first
-// that does not close a tenth of the holes (that one stays loaded, unused). HolePoints needs
-// the depth the depth-aware fill gives holes: with another fill no source is added. The
-// result's timings are those of its last render step; NovelView::ms covers them all. Throws
-// BadInputError when no source can contribute to the target. One `renderer` and one `view`
-// for all the views of a run keep their memory: fresh ones per 640x480 view page-fault ~65 MB.
+// Unseen pixels cover 0.1% of the image or more, adds up to `selection.hole_sources` more, one
+// at a time, each the source that sees most of UnseenPoints (SourceSeeingMost); it stops at the
+// first that does not show a tenth of them (that one stays loaded, unused). With a fill other
+// than the depth-aware one no source is added. The result's timings are those of its last
+// render step; NovelView::ms covers them all. Throws BadInputError when no source can
+// contribute to the target. One `renderer` and one `view` for all the views of a run keep
+// their memory: fresh ones per 640x480 view page-fault ~65 MB.
 void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                      const SourceSelectionOptions& selection, Renderer& renderer, NovelView* view);
 

@@ -27,8 +27,8 @@ struct SourceSelectionOptions {
   // see behind what the first ones' views hide. 0: plain score order. In [0, 180].
   double diversity_angle_deg = 10;
   // RenderNovelView: after rendering from the chosen sources, up to this many more are added
-  // one at a time while holes remain, each the source that sees most of the holes' hidden
-  // surface (SourceSeeingMost); >= 0.
+  // one at a time while holes or surfaces out of view remain, each the source that sees most
+  // of what they hide (SourceSeeingMost, of UnseenPoints); >= 0.
   int hole_sources = 2;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.

@@ -246,7 +246,7 @@ TEST(SourceSeeingMost, PicksTheViewThatSeesBehindTheOccluder) {
   const SourceView left = test::RenderView(scene, CameraAt(BoxCamera(), {-0.6, 0, 0}), "left");
   const PosedCamera target = CameraAt(BoxCamera(), {0, 0.05, 0});
   const RenderResult result = Render({&left}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
-  const std::vector<Eigen::Vector3d> points = HolePoints(result, target);
+  const std::vector<Eigen::Vector3d> points = UnseenPoints(result, target);
   ASSERT_GT(points.size(), 500u);
   for (const Eigen::Vector3d& point : points) ASSERT_NEAR(point.z(), 8, 0.1);  // The wall.
   const Eigen::Quaterniond away(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
@@ -259,6 +259,31 @@ TEST(SourceSeeingMost, PicksTheViewThatSeesBehindTheOccluder) {
   // which is not known before it is loaded); the one looking away never does.
   EXPECT_EQ(SourceSeeingMost(candidates, target, points, {2}, 32, options), 0);
   EXPECT_EQ(SourceSeeingMost(candidates, target, points, {0, 2}, 32, options), -1);
+}
+
+// A target moved right of its only source sees a strip of the wall past the source's frame:
+// out of view, and the fill continues the wall into it. Those pixels are unseen, their points
+// lie on the wall, and a camera further right sees them where one to the left does not.
+TEST(SourceSeeingMost, PicksTheViewThatSeesPastTheSourcesFrame) {
+  const Camera camera = MakePinholeCamera(1, 320, 240, 300, 300, 160, 120);
+  Scene scene;
+  scene.planes.push_back(test::WallAt(5, test::WavyTexture({0.45f, 0.4f, 0.35f}, 0.4)));
+  const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
+  // 30 px of disparity: the right 30 columns are out of the source's view.
+  const PosedCamera target = CameraAt(camera, {0.5, 0, 0});
+  const RenderResult result = Render({&source}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
+  EXPECT_EQ(result.metrics.hole_ratio, 0);
+  for (int y = 0; y < 240; y += 10) {
+    EXPECT_TRUE(Unseen(result, 315, y)) << y;
+    EXPECT_FALSE(Unseen(result, 280, y)) << y;
+  }
+  const std::vector<Eigen::Vector3d> points = UnseenPoints(result, target);
+  EXPECT_NEAR(static_cast<double>(points.size()), 15 * 120, 2 * 120);  // Every other pixel.
+  for (const Eigen::Vector3d& point : points) ASSERT_NEAR(point.z(), 5, 0.01);
+  const std::vector<PosedCamera> candidates = {CameraAt(camera, {-0.5, 0, 0}),
+                                               CameraAt(camera, {1.0, 0, 0})};
+  EXPECT_EQ(SourceSeeingMost(candidates, target, points, {}, 32, {}), 1);
+  EXPECT_EQ(SourceSeeingMost(candidates, target, points, {1}, 32, {}), -1);
 }
 
 // A target below the source and tilted up sees sky above the source's frame. At finite depth
