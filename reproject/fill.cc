@@ -429,6 +429,11 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
                                 std::to_string(blend->color.Width()) + "x" +
                                 std::to_string(blend->color.Height()));
   }
+  if (!classes.open_to_sky.empty() && classes.open_to_sky.size() != classes.classes.size()) {
+    throw std::invalid_argument("FillHoles: open_to_sky has " +
+                                std::to_string(classes.open_to_sky.size()) + " entries for " +
+                                std::to_string(classes.classes.size()) + " pixels");
+  }
   if (pinhole.width != classes.width || pinhole.height != classes.height) {
     throw std::invalid_argument("FillHoles: camera " + std::to_string(pinhole.width) + "x" +
                                 std::to_string(pinhole.height) + " does not match the image " +

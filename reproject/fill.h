@@ -52,13 +52,14 @@ struct FillSummary {
 // fill_out_of_view). kDepthAware scans `directions` rays from the pixel to the nearest pixel
 // with a sample, keeps the candidates whose depth is the farthest (background at infinity
 // counts as farthest, except for holes: see hole_sky_share) within background_tolerance, and
-// averages their colours weighted by inverse distance; surface fills also get that averaged depth. A disocclusion is hidden
-// background, so its colour comes from the background side, not from the occluder. Where the
-// background side is background at infinity, the colour comes from a sky model instead: an
-// affine function of the viewing ray through `camera` (the target's), fitted to the pixels
-// where background landed, so sky nothing saw continues the gradient of the sky around it.
+// averages their colours weighted by inverse distance; surface fills also get that averaged
+// depth. A disocclusion is hidden background, so its colour comes from the background side,
+// not from the occluder. Where the background side is background at infinity, the colour
+// comes from a sky model instead: an affine function of the viewing ray through `camera` (the
+// target's), fitted to the pixels where background landed, so sky nothing saw continues the
+// gradient of the sky around it.
 // The sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad
-// options, a non-pinhole camera, or a class map or camera of another size.
+// options, a non-pinhole camera, or a class map (or its open_to_sky) or camera of another size.
 FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillOptions& options,
                       BlendResult* blend);
 

@@ -43,12 +43,16 @@ struct ClassMap {
   int height = 0;
   std::vector<PixelClass> classes;  // Row-major.
   // Row-major, 1 for a hole pixel whose direction no source saw without knowing its depth:
-  // each source looking that way saw a surface (or nothing), and the sky may lie behind it.
-  // Empty where that is not known (some source without depth): no hole is open to the sky.
+  // each source looking that way saw a surface at a known depth (or sky, or the direction lies
+  // outside it), and the sky may lie behind that surface. With ground-truth depth nearly every
+  // hole is open; FillOptions::hole_sky_share decides whether the sky is taken. Empty when
+  // not known (some source without depth): no hole is open to the sky.
   std::vector<uint8_t> open_to_sky;
 
   PixelClass At(int x, int y) const { return classes[Index(x, y)]; }
-  bool OpenToSky(int x, int y) const { return !open_to_sky.empty() && open_to_sky[Index(x, y)] != 0; }
+  bool OpenToSky(int x, int y) const {
+    return !open_to_sky.empty() && open_to_sky[Index(x, y)] != 0;
+  }
 
  private:
   size_t Index(int x, int y) const {

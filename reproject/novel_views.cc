@@ -267,13 +267,13 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   const ForwardWarpOptions& warp = renderer.Options().warp;
   for (int index : chosen) sources.push_back(&library.Load(index, warp));
   Clock::duration spent = select_end - select_start;
-  auto render_start = Clock::now();
-  renderer.Render(sources, target.camera, &view->result);
-  spent += Clock::now() - render_start;
   // More sources, one at a time, while unseen pixels remain and some source sees them.
   const int hole_sources =
       renderer.Options().fill.method == FillMethod::kDepthAware ? selection.hole_sources : 0;
+  auto render_start = Clock::now();
+  renderer.Render(sources, target.camera, &view->result);
   double unseen = hole_sources > 0 ? UnseenRatio(view->result) : 0.0;
+  spent += Clock::now() - render_start;
   for (int extra = 0; extra < hole_sources; ++extra) {
     if (unseen < kMinUnseenRatioForMoreSources) break;
     const auto pick_start = Clock::now();
@@ -286,10 +286,10 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     render_start = Clock::now();
     RenderResult more;
     renderer.RenderWithOneMore(source, &more);
+    const double unseen_after = UnseenRatio(more);
     spent += Clock::now() - render_start;
     // Kept only when it shows a tenth of the unseen pixels at least: else it did not see
     // them after all (occluded as well), and the render without it stands.
-    const double unseen_after = UnseenRatio(more);
     if (!(unseen_after < kKeptUnseenShare * unseen)) break;
     chosen.push_back(pick);
     view->result = std::move(more);

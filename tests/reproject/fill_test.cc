@@ -128,8 +128,8 @@ TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
 }
 
 // Sky above row 30, ground (blue, depth 5) below, and a 10 x 10 hole just above the ground:
-// from its pixels the nine directions up and along the row find sky, the seven down find
-// ground. Open to the sky, half the directions suffice for the sky; not open (or with all
+// from its pixels the directions up and along the row (nine of sixteen, more near the hole's
+// sides, where shallow marches down leave it sideways) find sky, the others ground. Open to the sky, half the directions suffice for the sky; not open (or with all
 // directions asked for), the hole takes the ground, as any hole beside a surface did before.
 TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
   constexpr int kSize = 40, kGround = 30;

@@ -163,6 +163,28 @@ TEST(ForwardWarp, OutlineSamplesSplatAShareOfTheirFootprint) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
+// A pole one source column wide (x 0.01..0.03 at z 4: only column 80's centre, 80.5, lies on
+// it) in front of the wall, seen with the principal point half a pixel to the right: its
+// samples land halfway between two target columns. Its outline on both sides would shrink its
+// footprint to 0.66 pixel, which holds no pixel centre; one sample wide, it keeps the full
+// 1.1 and shows in every row.
+TEST(ForwardWarp, StructuresOneSampleWideKeepTheirFootprint) {
+  Scene scene;
+  scene.planes.push_back(test::WallAt(8, test::WavyTexture({0.1f, 0.2f, 0.7f}, 0.8)));
+  scene.boxes.push_back({{0.01, -0.4, 4}, {0.03, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
+  const SourceView source = test::RenderView(scene, CameraAt(TestCamera(), {0, 0, 0}));
+  const PosedCamera target =
+      CameraAt(MakePinholeCamera(1, 160, 120, 150, 150, 80.5, 60), {0, 0, 0});
+  WarpBuffer buffer;
+  ForwardWarp(source, target, {}, &buffer);
+  // Rows 45..74 have their centres on the pole (y -0.4..0.4 at z 4).
+  for (int y = 45; y < 75; ++y) {
+    int pole = 0;
+    for (int x = 78; x < 84; ++x) pole += std::abs(buffer.Depth(static_cast<size_t>(y * 160 + x)) - 4.0f) < 0.01f ? 1 : 0;
+    EXPECT_EQ(pole, 2) << y;
+  }
+}
+
 TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
   const Camera camera = TestCamera();
   const SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
