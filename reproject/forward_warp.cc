@@ -432,14 +432,12 @@ class SourceWarper {
     return false;
   }
 
-  // Whether the sample at (nx, ny) lies beyond surface sample i, seen from the source: sky,
-  // unknown depth, or a surface farther than one surface's depth ratio; outside the image, no.
-  // Unknown depth counts so that an occluder beside estimated depth's eroded edges still
-  // shrinks (estimated courtyard views 28.42 dB; 28.34 with unknown depth counting as
-  // neither), though nothing on the far side of that gap grows to meet it.
-  bool Beyond(size_t i, int nx, int ny) const {
-    if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) return false;
-    const size_t j = Index(nx, ny);
+  // Whether sample j lies beyond surface sample i, seen from the source: sky, unknown depth,
+  // or a surface farther than one surface's depth ratio. Unknown depth counts so that an
+  // occluder beside estimated depth's eroded edges still shrinks (estimated courtyard views
+  // 28.42 dB; 28.34 with unknown depth counting as neither), though nothing on the far side
+  // of that gap grows to meet it.
+  bool Beyond(size_t i, size_t j) const {
     return vtx_.kind[j] != kSurface || SourceDepth(j) > s_.max_depth_ratio * SourceDepth(i);
   }
 
@@ -458,13 +456,18 @@ class SourceWarper {
     for (int ny = std::max(0, y - 1); ny <= std::min(height_ - 1, y + 1); ++ny) {
       for (int nx = std::max(0, x - 1); nx <= std::min(width_ - 1, x + 1); ++nx) {
         const size_t j = Index(nx, ny);
-        near_side = near_side || (surface && Beyond(i, nx, ny));
-        far_side = far_side || (vtx_.kind[j] == kSurface && Beyond(j, x, y));
+        near_side = near_side || (surface && Beyond(i, j));
+        far_side = far_side || (vtx_.kind[j] == kSurface && Beyond(j, i));
       }
     }
-    const bool one_wide = near_side && ((Beyond(i, x - 1, y) && Beyond(i, x + 1, y)) ||
-                                        (Beyond(i, x, y - 1) && Beyond(i, x, y + 1)));
-    if (near_side == far_side || one_wide) return 1.0f;
+    if (near_side == far_side) return 1.0f;
+    // Opposite neighbours inside the image, both Beyond.
+    const auto beyond_both = [&](int dx, int dy) {
+      const int ax = x - dx, ay = y - dy, bx = x + dx, by = y + dy;
+      return ax >= 0 && ay >= 0 && bx < width_ && by < height_ && Beyond(i, Index(ax, ay)) &&
+             Beyond(i, Index(bx, by));
+    };
+    if (near_side && (beyond_both(1, 0) || beyond_both(0, 1))) return 1.0f;
     const auto share = static_cast<float>(options_.outline_splat_share);
     return near_side ? share : 2.0f - share;
   }
