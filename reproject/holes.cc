@@ -72,9 +72,11 @@ enum class PointView { kOutside, kFree, kHidden, kUnknown };
 // What source `s` knows of the point at inverse depth `inv_depth` (0: the direction) on the
 // target ray whose source-frame direction is `dir`: outside its image, empty space (its depth
 // there is larger, or background), hidden (its depth is not larger), or unknown (depth 0 that
-// is not background: the source saw something there, at a depth nobody knows).
-PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir, double inv_depth,
-                      double tolerance) {
+// is not background: the source saw something there, at a depth nobody knows). Inline: with
+// two callers GCC stopped inlining it into RayIsHole's loop (classification 2.78 -> 3.0 ms in
+// the K=4 render core).
+inline PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir,
+                             double inv_depth, double tolerance) {
   // The point scaled by inv_depth: the same pixel, and z / depth = p.z().
   const Eigen::Vector3d p = s.origin * inv_depth + dir;
   if (!(p.z() > 0)) return PointView::kOutside;
