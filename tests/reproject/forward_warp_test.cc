@@ -137,10 +137,18 @@ TEST(ForwardWarp, SilhouetteSamplesWeighLess) {
 // pixel short of a centre on either side; their full footprint (0.55 pixel either way) takes
 // one more column on each side, a share of 0.6 does not, and the wall's samples beside the
 // outline (1.4 of theirs) cover those columns: no hole opens.
+// The test camera with its principal point half a pixel to the right: every source sample of
+// an identity warp lands halfway between two target pixel centres.
+PosedCamera HalfPixelRight() {
+  return CameraAt(MakePinholeCamera(1, 160, 120, 150, 150, 80.5, 60), {0, 0, 0});
+}
+
+// A sample of a surface at depth 4 (the box's front face, the pole).
+bool AtDepth4(float depth) { return std::abs(depth - 4.0f) < 0.01f; }
+
 TEST(ForwardWarp, OutlineSamplesSplatAShareOfTheirFootprint) {
   const SourceView source = test::RenderView(BoxScene(), CameraAt(TestCamera(), {0, 0, 0}));
-  const PosedCamera target =
-      CameraAt(MakePinholeCamera(1, 160, 120, 150, 150, 80.5, 60), {0, 0, 0});
+  const PosedCamera target = HalfPixelRight();
   const auto front_face_pixels = [&](double share) {
     ForwardWarpOptions options;
     options.outline_splat_share = share;
@@ -148,7 +156,7 @@ TEST(ForwardWarp, OutlineSamplesSplatAShareOfTheirFootprint) {
     ForwardWarp(source, target, options, &buffer);
     int count = 0, holes = 0;
     for (size_t i = 0; i < buffer.Size(); ++i) {
-      count += std::abs(buffer.Depth(i) - 4.0f) < 0.01f ? 1 : 0;
+      count += AtDepth4(buffer.Depth(i)) ? 1 : 0;
       holes += buffer.Depth(i) == 0 ? 1 : 0;
     }
     EXPECT_EQ(holes, 0) << share;
@@ -173,14 +181,13 @@ TEST(ForwardWarp, StructuresOneSampleWideKeepTheirFootprint) {
   scene.planes.push_back(test::WallAt(8, test::WavyTexture({0.1f, 0.2f, 0.7f}, 0.8)));
   scene.boxes.push_back({{0.01, -0.4, 4}, {0.03, 0.4, 5}, test::WavyTexture({0.7f, 0.2f, 0.1f}, 0.3)});
   const SourceView source = test::RenderView(scene, CameraAt(TestCamera(), {0, 0, 0}));
-  const PosedCamera target =
-      CameraAt(MakePinholeCamera(1, 160, 120, 150, 150, 80.5, 60), {0, 0, 0});
+  const PosedCamera target = HalfPixelRight();
   WarpBuffer buffer;
   ForwardWarp(source, target, {}, &buffer);
   // Rows 45..74 have their centres on the pole (y -0.4..0.4 at z 4).
   for (int y = 45; y < 75; ++y) {
     int pole = 0;
-    for (int x = 78; x < 84; ++x) pole += std::abs(buffer.Depth(static_cast<size_t>(y * 160 + x)) - 4.0f) < 0.01f ? 1 : 0;
+    for (int x = 78; x < 84; ++x) pole += AtDepth4(buffer.Depth(static_cast<size_t>(y * 160 + x))) ? 1 : 0;
     EXPECT_EQ(pole, 2) << y;
   }
 }
