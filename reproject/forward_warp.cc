@@ -547,12 +547,12 @@ void WarpBuffer::Reset(int width, int height) {
   height_ = height;
   const size_t count = Size();
   if (count > capacity_) {
-    Allocate(&depth_, count);
+    Allocate(&depth_, count + kPadding);
     Allocate(&color_, 3 * count);
     Allocate(&weight_, count);
     capacity_ = count;
   }
-  std::fill(depth_.get(), depth_.get() + count, 0.0f);
+  std::fill(depth_.get(), depth_.get() + count + kPadding, 0.0f);
 }
 
 WarpScratch::WarpScratch() : data_(std::make_unique<Data>()) {}

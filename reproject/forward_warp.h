@@ -103,6 +103,10 @@ class WarpBuffer {
   float* MutableWeight() { return weight_.get(); }
 
  private:
+  // Depths past the last pixel, so that the rasteriser can read and write a row's last pixels
+  // four at a time.
+  static constexpr size_t kPadding = 3;
+
   int width_ = 0;
   int height_ = 0;
   size_t capacity_ = 0;

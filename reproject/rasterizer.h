@@ -9,6 +9,10 @@
 #include <cstring>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "core/image.h"
 #include "reproject/forward_warp.h"
 
@@ -105,6 +109,15 @@ struct AttributePlanes {
 using F4 = float __attribute__((vector_size(16)));
 using I4 = int32_t __attribute__((vector_size(16)));
 
+// Bit k set where lane k of a comparison result is true.
+inline int LaneBits(I4 mask) {
+#if defined(__SSE2__)
+  return _mm_movemask_ps(reinterpret_cast<__m128>(mask));
+#else
+  return (mask[0] & 1) | (mask[1] & 2) | (mask[2] & 4) | (mask[3] & 8);
+#endif
+}
+
 // A triangle's attributes at four pixels: depth, source position relative to the block's
 // first corner, ray angle; `front`: in front of the camera (always, for background).
 struct Lanes {
@@ -161,7 +174,8 @@ class Rasterizer {
         weight_(buffer->MutableWeight()),
         texture_(texture.Pixels().data()),
         texture_width_(texture.Width()),
-        texture_height_(texture.Height()) {}
+        texture_height_(texture.Height()),
+        texture_end_(texture.Pixels().data() + texture.Pixels().size()) {}
 
   // Perspective-correct: inverse depth is affine in the image, attributes / z too.
   void SurfaceTriangle(const Corner& a, const Corner& b, const Corner& c) {
@@ -216,21 +230,8 @@ class Rasterizer {
         const I4 in_2 = use_2 & lanes_2.front & (lanes_2.fx <= side + slack) &
                         (lanes_2.fy <= side + slack) & (lanes_2.fx + lanes_2.fy >= side - slack);
         const int count = std::min(4, box.x1 - x + 1);
-        for (int k = 0; k < count; ++k) {
-          const bool on_1 = in_1[k] != 0;
-          if (!on_1 && in_2[k] == 0) continue;
-          const Lanes& l = on_1 ? lanes_1 : lanes_2;
-          const size_t i = Index(x + k, y);
-          const float stretch = on_1 ? first.stretch : second.stretch;
-          if constexpr (kBackground) {
-            if (depth_[i] != 0) continue;
-            WriteSample(i, WarpBuffer::kBackground, a.sx + l.fx[k], a.sy + l.fy[k], 0.0f, stretch);
-          } else {
-            const float z = l.z[k];
-            if (!Nearer(i, z) || !Finite(z)) continue;
-            WriteSample(i, z, a.sx + l.fx[k], a.sy + l.fy[k], l.angle[k], stretch);
-          }
-        }
+        WriteGroup<kBackground>(Index(x, y), count, in_1, lanes_1, first.stretch, in_2, lanes_2,
+                                second.stretch, a);
       }
     }
   }
@@ -365,33 +366,101 @@ class Rasterizer {
     return 1.0f / ((angle + angle_epsilon_) * std::max(1.0f, stretch));
   }
 
-  // A sample whose colour is the source's, bilinear at source pixel (sx, sy).
-  void WriteSample(size_t i, float depth, float sx, float sy, float angle, float stretch) {
-    depth_[i] = depth;
-    weight_[i] = Weight(angle, stretch);
-    if (stretch > bicubic_min_stretch_ && sx >= 1 && sy >= 1 &&
-        sx < static_cast<float>(texture_width_ - 2) &&
-        sy < static_cast<float>(texture_height_ - 3)) {
-      Bicubic(i, sx, sy);
+  // Writes the lanes of a four-pixel group (target pixels i to i + count - 1 of one row) that
+  // lie in one of a block's two triangles (in_1 / in_2, the first where both: their shared
+  // edge) and pass the z-test: depth and weight for all four at once, then the colour of each
+  // written lane, sampled from the source at its position (relative to corner a's).
+  template <bool kBackground>
+  void WriteGroup(size_t i, int count, I4 in_1, const Lanes& lanes_1, float stretch_1, I4 in_2,
+                  const Lanes& lanes_2, float stretch_2, const Corner& a) {
+    const I4 in = (in_1 | in_2) & (I4{0, 1, 2, 3} < count);
+    if (LaneBits(in) == 0) return;
+    // Four depths even where fewer pixels are left in the row: the buffer is padded, and
+    // lanes not written are stored back unchanged.
+    const F4 depth = Load4(depth_ + i);
+    F4 z, angle;
+    I4 write;
+    if constexpr (kBackground) {
+      z = F4{} + WarpBuffer::kBackground;
+      angle = F4{};
+      write = in & (depth == 0);
+    } else {
+      z = in_1 ? lanes_1.z : lanes_2.z;
+      angle = in_1 ? lanes_1.angle : lanes_2.angle;
+      // In front of the camera (Lanes::front), so finite is z <= max; NaN fails both tests.
+      write = in & ((depth == 0) | (z < depth)) & (z <= kFloatMax);
+    }
+    const int bits = LaneBits(write);
+    if (bits == 0) return;
+    Store4(depth_ + i, write ? z : depth);
+    const F4 stretch = in_1 ? F4{} + stretch_1 : F4{} + stretch_2;
+    const F4 weight = 1.0f / ((angle + angle_epsilon_) * (stretch > 1.0f ? stretch : F4{} + 1.0f));
+    const F4 sx = a.sx + (in_1 ? lanes_1.fx : lanes_2.fx);
+    const F4 sy = a.sy + (in_1 ? lanes_1.fy : lanes_2.fy);
+    const Taps taps = TapsAt(sx, sy, stretch);
+    for (int k = 0; k < 4; ++k) {
+      if ((bits >> k & 1) == 0) continue;
+      const size_t pixel = i + static_cast<size_t>(k);
+      weight_[pixel] = weight[k];
+      if (taps.bicubic[k] != 0) {
+        Bicubic(pixel, sx[k], sy[k]);
+      } else {
+        Bilinear(pixel, taps, k);
+      }
+    }
+  }
+
+  // Where four samples at source pixels (sx, sy) read the source: bicubic where magnified (or
+  // always, TextureFilter::kBicubic) and inside by a pixel, else bilinear from the pixel
+  // (x0, y0) at or before the position, its right and lower neighbours (the pixel itself on
+  // the last column / row) and weights.
+  struct Taps {
+    I4 bicubic, x0, y0, step_x, step_y;  // Steps in floats.
+    F4 w00, w10, w01, w11;
+  };
+
+  Taps TapsAt(F4 sx, F4 sy, F4 stretch) const {
+    const float last_x = static_cast<float>(texture_width_ - 1);
+    const float last_y = static_cast<float>(texture_height_ - 1);
+    Taps t;
+    t.bicubic = (stretch > bicubic_min_stretch_) & (sx >= 1.0f) & (sy >= 1.0f) &
+                (sx < last_x - 1.0f) & (sy < last_y - 2.0f);
+    // Clamped to the image (the interpolation can overshoot a corner by a hair; NaN to 0);
+    // then non-negative, so truncation is floor.
+    sx = sx > 0.0f ? sx : F4{};
+    sy = sy > 0.0f ? sy : F4{};
+    sx = sx < last_x ? sx : F4{} + last_x;
+    sy = sy < last_y ? sy : F4{} + last_y;
+    t.x0 = __builtin_convertvector(sx, I4);
+    t.y0 = __builtin_convertvector(sy, I4);
+    const F4 fx = sx - __builtin_convertvector(t.x0, F4);
+    const F4 fy = sy - __builtin_convertvector(t.y0, F4);
+    t.step_x = (t.x0 < texture_width_ - 1) & 3;
+    t.step_y = (t.y0 < texture_height_ - 1) & (3 * texture_width_);
+    t.w00 = (1 - fx) * (1 - fy);
+    t.w10 = fx * (1 - fy);
+    t.w01 = (1 - fx) * fy;
+    t.w11 = fx * fy;
+    return t;
+  }
+
+  // Lane k of `taps` into target pixel i.
+  void Bilinear(size_t i, const Taps& taps, int k) {
+    const float* t00 = texture_ + 3 * (static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_) +
+                                       static_cast<size_t>(taps.x0[k]));
+    const float* t10 = t00 + taps.step_x[k];
+    const float* t01 = t00 + taps.step_y[k];
+    const float* t11 = t01 + taps.step_x[k];
+    const float w00 = taps.w00[k], w10 = taps.w10[k], w01 = taps.w01[k], w11 = taps.w11[k];
+    float* out = color_ + 3 * i;
+    // Four lanes per tap (RGB and the next pixel's R, dropped), except at the last pixel,
+    // which has no next one.
+    if (t11 + 3 < texture_end_) {
+      const F4 rgb = w00 * Load4(t00) + w10 * Load4(t10) + w01 * Load4(t01) + w11 * Load4(t11);
+      for (int c = 0; c < 3; ++c) out[c] = rgb[c];
       return;
     }
-    // Clamped to the image (the interpolation can overshoot a corner by a hair); then
-    // non-negative, so truncation is floor.
-    sx = std::clamp(sx, 0.0f, static_cast<float>(texture_width_ - 1));
-    sy = std::clamp(sy, 0.0f, static_cast<float>(texture_height_ - 1));
-    const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
-    const int x1 = std::min(x0 + 1, texture_width_ - 1), y1 = std::min(y0 + 1, texture_height_ - 1);
-    const float fx = sx - static_cast<float>(x0), fy = sy - static_cast<float>(y0);
-    const size_t row0 = static_cast<size_t>(y0) * static_cast<size_t>(texture_width_);
-    const size_t row1 = static_cast<size_t>(y1) * static_cast<size_t>(texture_width_);
-    const float* t00 = texture_ + 3 * (row0 + static_cast<size_t>(x0));
-    const float* t10 = texture_ + 3 * (row0 + static_cast<size_t>(x1));
-    const float* t01 = texture_ + 3 * (row1 + static_cast<size_t>(x0));
-    const float* t11 = texture_ + 3 * (row1 + static_cast<size_t>(x1));
-    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
-    for (int k = 0; k < 3; ++k) {
-      color_[3 * i + k] = w00 * t00[k] + w10 * t10[k] + w01 * t01[k] + w11 * t11[k];
-    }
+    for (int c = 0; c < 3; ++c) out[c] = w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
   }
 
   // Where the target samples the source more densely than its pixels (magnified), and
@@ -415,12 +484,13 @@ class Rasterizer {
     for (int k = 0; k < 3; ++k) color_[3 * i + k] = std::max(rgb[k], 0.0f);
   }
 
-  // An RGB pixel and the next pixel's R in the fourth lane (the caller drops it).
+  // Four floats from anywhere (an RGB pixel and the next pixel's R, four depths).
   static F4 Load4(const float* p) {
     F4 value;
     std::memcpy(&value, p, sizeof(value));
     return value;
   }
+  static void Store4(float* p, F4 value) { std::memcpy(p, &value, sizeof(value)); }
 
   static void CatmullRom(float t, float w[4]) {
     const float t2 = t * t, t3 = t2 * t;
@@ -443,6 +513,7 @@ class Rasterizer {
   const float* texture_;
   int texture_width_;
   int texture_height_;
+  const float* texture_end_;
 };
 
 
