@@ -2,6 +2,7 @@
 // Forward warp of one source view into a target camera with a z-buffer (nearest wins).
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <vector>
@@ -69,6 +70,13 @@ struct ForwardWarpOptions {
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
 
+// A per-pixel array of the warp (see Allocate in forward_warp.cc), freed with std::free.
+struct FreeDeleter {
+  void operator()(void* memory) const noexcept { std::free(memory); }
+};
+template <typename T>
+using PixelArray = std::unique_ptr<T[], FreeDeleter>;
+
 // One source warped into the target, target-sized, struct of arrays, index y * width + x.
 class WarpBuffer {
  public:
@@ -110,9 +118,9 @@ class WarpBuffer {
   int width_ = 0;
   int height_ = 0;
   size_t capacity_ = 0;
-  std::unique_ptr<float[]> depth_;
-  std::unique_ptr<float[]> color_;
-  std::unique_ptr<float[]> weight_;
+  PixelArray<float> depth_;
+  PixelArray<float> color_;
+  PixelArray<float> weight_;
 };
 
 // Per-source-pixel memory a warp needs (projections, masks); keeping one between calls saves
