@@ -272,7 +272,7 @@ class SourceWarper {
   // Blocks of kMaxBlock x kMaxBlock source pixels whose quads all join one surface are drawn
   // as one quad (a plane is exact under perspective, a curved surface within a small fraction
   // of a pixel), others split in four down to single quads: most of the image costs one
-  // quad setup per 16 source pixels. Vertices next to a dropped triangle or on the source
+  // quad setup per 64 source pixels. Vertices next to a dropped triangle or on the source
   // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
   // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
   // source's stride.
@@ -319,15 +319,19 @@ class SourceWarper {
   Sample At(int x, int y) const { return {Index(x, y), x, y}; }
 
   Corner CornerAt(const Sample& p) const {
+    const float depth = SourceDepth(p.i);
     return {vtx_.u[p.i], vtx_.v[p.i], vtx_.inv_z[p.i], vtx_.angle[p.i],
             source_.color.Pixels().data() + 3 * p.i, static_cast<float>(p.x),
-            static_cast<float>(p.y)};
+            static_cast<float>(p.y), depth > 0 ? depth : 1.0f};
   }
 
   // Marks a vertex for splatting.
   void MarkEdge(size_t i) { (*edge_)[i] = 1; }
 
-  static constexpr int kMaxBlock = 4;
+  // 8: courtyard novel views from ground-truth sources 33.50 dB with 4, 8 and 16 alike (before
+  // the source position was interpolated in homogeneous coordinates, 8 lost 0.13 dB to 4 on
+  // grazing ground); one 640x480 warp ~6.5 -> ~6.2 ms, K=4 at 1920x1080 ~204 -> ~190 ms.
+  static constexpr int kMaxBlock = 8;
   // Relative inverse-depth deviation from the corners' blend within which a block is flat:
   // its samples land within ~kFlatTolerance x (disparity in pixels) of where they should.
   static constexpr float kFlatTolerance = 1e-3f;

@@ -14,7 +14,7 @@ namespace parallax {
 enum class WarpMethod {
   kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
   kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct; flat
-           // 4x4 or 2x2 blocks of one surface (or of background) as one quad, the colour
+           // 8x8, 4x4 or 2x2 blocks of one surface (or of background) as one quad, the colour
            // sampled from the source at the interpolated source position (TextureFilter).
 };
 

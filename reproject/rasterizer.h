@@ -34,17 +34,25 @@ struct Corner {
   float u, v, inv_z, angle;
   const float* rgb;
   float sx, sy;  // Source pixel (column, row) whose centre this is.
+  float source_depth;  // Its depth in the source; 1 for background.
 };
 
 // One triangle of a textured block: barycentric weights as affine functions of the pixel
 // centre, relative to the first corner (small numbers, so float keeps them exact to ~1e-6 of
 // the block), and per-corner attributes (times 1 / z for surfaces: those are affine in the
 // image), the source position relative to (origin_sx, origin_sy).
+//
+// The source position is not affine on a surface (it is the source's projection), but the
+// source's homogeneous coordinates are: source depth times position, and source depth. So a
+// surface's corners carry position times source depth and source depth itself (`source_w`),
+// both times 1 / z; the position is their ratio, exact on a plane however its depth changes
+// across the block (interpolating the position itself would shift the texture where a block
+// spans a depth range in the source: ground at a grazing angle).
 struct TriangleSetup {
   float origin_u = 0, origin_v = 0;
   // w0 = 1 + w0_du * du + w0_dv * dv; w1 likewise from 0.
   float w0_du = 0, w0_dv = 0, w1_du = 0, w1_dv = 0;
-  float inv_z[3] = {}, sx[3] = {}, sy[3] = {}, angle[3] = {};
+  float inv_z[3] = {}, sx[3] = {}, sy[3] = {}, source_w[3] = {}, angle[3] = {};
   float stretch = 0;
 
   // False for a degenerate triangle.
@@ -65,9 +73,11 @@ struct TriangleSetup {
     const Corner* corners[3] = {&a, &b, &c};
     for (int k = 0; k < 3; ++k) {
       const float scale = kBackground ? 1.0f : corners[k]->inv_z;
+      const float homogeneous = kBackground ? 1.0f : scale * corners[k]->source_depth;
       inv_z[k] = corners[k]->inv_z;
-      sx[k] = (corners[k]->sx - origin_sx) * scale;
-      sy[k] = (corners[k]->sy - origin_sy) * scale;
+      source_w[k] = homogeneous;
+      sx[k] = (corners[k]->sx - origin_sx) * homogeneous;
+      sy[k] = (corners[k]->sy - origin_sy) * homogeneous;
       angle[k] = corners[k]->angle * scale;
     }
     return true;
@@ -83,7 +93,7 @@ struct Plane {
 
 // A triangle's attributes over z (TriangleSetup) as planes about (origin_u, origin_v).
 struct AttributePlanes {
-  Plane inv_z, sx, sy, angle;
+  Plane inv_z, sx, sy, source_w, angle;
   float stretch = 0;
 
   AttributePlanes(const TriangleSetup& t, float origin_u, float origin_v) : stretch(t.stretch) {
@@ -100,6 +110,7 @@ struct AttributePlanes {
     inv_z = plane(t.inv_z);
     sx = plane(t.sx);
     sy = plane(t.sy);
+    source_w = plane(t.source_w);
     angle = plane(t.angle);
   }
 };
@@ -127,16 +138,16 @@ struct Lanes {
 
 // AttributePlanes along one pixel row: value at du = 0 and slope in u.
 struct RowPlanes {
-  float inv_z, sx, sy, angle;
-  float d_inv_z, d_sx, d_sy, d_angle;
+  float inv_z, sx, sy, source_w, angle;
+  float d_inv_z, d_sx, d_sy, d_source_w, d_angle;
 
   RowPlanes(const AttributePlanes& p, float dv)
       : inv_z(p.inv_z.At(0, dv)), sx(p.sx.At(0, dv)), sy(p.sy.At(0, dv)),
-        angle(p.angle.At(0, dv)), d_inv_z(p.inv_z.d_u), d_sx(p.sx.d_u), d_sy(p.sy.d_u),
-        d_angle(p.angle.d_u) {}
+        source_w(p.source_w.At(0, dv)), angle(p.angle.At(0, dv)), d_inv_z(p.inv_z.d_u),
+        d_sx(p.sx.d_u), d_sy(p.sy.d_u), d_source_w(p.source_w.d_u), d_angle(p.angle.d_u) {}
 
   // Background planes are the attributes themselves (screen-affine); surface planes are
-  // attributes / z.
+  // attributes / z, the source position homogeneous (see TriangleSetup).
   template <bool kBackground>
   Lanes At(F4 du) const {
     Lanes l;
@@ -150,8 +161,9 @@ struct RowPlanes {
       const F4 inv = inv_z + du * d_inv_z;
       // Lanes behind the camera divide to garbage and are dropped by `front`.
       l.z = 1.0f / inv;
-      l.fx = (sx + du * d_sx) * l.z;
-      l.fy = (sy + du * d_sy) * l.z;
+      const F4 inv_w = 1.0f / (source_w + du * d_source_w);
+      l.fx = (sx + du * d_sx) * inv_w;
+      l.fy = (sy + du * d_sy) * inv_w;
       l.angle = (angle + du * d_angle) * l.z;
       l.front = inv > 0;
     }
