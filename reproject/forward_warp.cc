@@ -319,10 +319,9 @@ class SourceWarper {
   Sample At(int x, int y) const { return {Index(x, y), x, y}; }
 
   Corner CornerAt(const Sample& p) const {
-    const float depth = SourceDepth(p.i);
     return {vtx_.u[p.i], vtx_.v[p.i], vtx_.inv_z[p.i], vtx_.angle[p.i],
             source_.color.Pixels().data() + 3 * p.i, static_cast<float>(p.x),
-            static_cast<float>(p.y), depth > 0 ? depth : 1.0f};
+            static_cast<float>(p.y)};
   }
 
   // Marks a vertex for splatting.
@@ -377,12 +376,13 @@ class SourceWarper {
     if (kind != kInvalid) {
       const Corner a = CornerAt(At(x, y)), b = CornerAt(At(x + side, y));
       const Corner c = CornerAt(At(x, y + side)), d = CornerAt(At(x + side, y + side));
-      if (kind == kSurface) {
-        raster_->TexturedBlock<false>(a, b, c, d, static_cast<float>(side));
-      } else {
-        raster_->TexturedBlock<true>(a, b, c, d, static_cast<float>(side));
+      const auto fside = static_cast<float>(side);
+      // Not drawn where the target quad is not convex (seen edge-on): smaller blocks, or the
+      // two triangles of a single quad, below.
+      if (kind == kSurface ? raster_->TexturedBlock<false>(a, b, c, d, fside)
+                           : raster_->TexturedBlock<true>(a, b, c, d, fside)) {
+        return;
       }
-      return;
     }
     if (side > 1) {
       const int half = side / 2;

@@ -34,85 +34,6 @@ struct Corner {
   float u, v, inv_z, angle;
   const float* rgb;
   float sx, sy;  // Source pixel (column, row) whose centre this is.
-  float source_depth;  // Its depth in the source; 1 for background.
-};
-
-// One triangle of a textured block: barycentric weights as affine functions of the pixel
-// centre, relative to the first corner (small numbers, so float keeps them exact to ~1e-6 of
-// the block), and per-corner attributes (times 1 / z for surfaces: those are affine in the
-// image), the source position relative to (origin_sx, origin_sy).
-//
-// The source position is not affine on a surface (it is the source's projection), but the
-// source's homogeneous coordinates are: source depth times position, and source depth. So a
-// surface's corners carry position times source depth and source depth itself (`source_w`),
-// both times 1 / z; the position is their ratio, exact on a plane however its depth changes
-// across the block (interpolating the position itself would shift the texture where a block
-// spans a depth range in the source: ground at a grazing angle).
-struct TriangleSetup {
-  float origin_u = 0, origin_v = 0;
-  // w0 = 1 + w0_du * du + w0_dv * dv; w1 likewise from 0.
-  float w0_du = 0, w0_dv = 0, w1_du = 0, w1_dv = 0;
-  float inv_z[3] = {}, sx[3] = {}, sy[3] = {}, source_w[3] = {}, angle[3] = {};
-  float stretch = 0;
-
-  // False for a degenerate triangle.
-  template <bool kBackground>
-  bool Init(const Corner& a, const Corner& b, const Corner& c, float source_area2,
-            float origin_sx, float origin_sy) {
-    const float bu = b.u - a.u, bv = b.v - a.v, cu = c.u - a.u, cv = c.v - a.v;
-    const float area2 = bu * cv - bv * cu;
-    if (!(std::abs(area2) > 1e-12f) || !Finite(area2)) return false;
-    const float inv_area = 1.0f / area2;
-    origin_u = a.u;
-    origin_v = a.v;
-    w0_du = (bv - cv) * inv_area;
-    w0_dv = (cu - bu) * inv_area;
-    w1_du = cv * inv_area;
-    w1_dv = -cu * inv_area;
-    stretch = std::abs(area2) / source_area2;
-    const Corner* corners[3] = {&a, &b, &c};
-    for (int k = 0; k < 3; ++k) {
-      const float scale = kBackground ? 1.0f : corners[k]->inv_z;
-      const float homogeneous = kBackground ? 1.0f : scale * corners[k]->source_depth;
-      inv_z[k] = corners[k]->inv_z;
-      source_w[k] = homogeneous;
-      sx[k] = (corners[k]->sx - origin_sx) * homogeneous;
-      sy[k] = (corners[k]->sy - origin_sy) * homogeneous;
-      angle[k] = corners[k]->angle * scale;
-    }
-    return true;
-  }
-};
-
-// An attribute affine in the image: value + du * d_u + dv * d_v, with du, dv relative to an
-// origin near the triangle.
-struct Plane {
-  float value = 0, d_u = 0, d_v = 0;
-  float At(float du, float dv) const { return value + du * d_u + dv * d_v; }
-};
-
-// A triangle's attributes over z (TriangleSetup) as planes about (origin_u, origin_v).
-struct AttributePlanes {
-  Plane inv_z, sx, sy, source_w, angle;
-  float stretch = 0;
-
-  AttributePlanes(const TriangleSetup& t, float origin_u, float origin_v) : stretch(t.stretch) {
-    // The barycentric weights as planes about the new origin.
-    const float ou = origin_u - t.origin_u, ov = origin_v - t.origin_v;
-    const Plane w0{1.0f + t.w0_du * ou + t.w0_dv * ov, t.w0_du, t.w0_dv};
-    const Plane w1{t.w1_du * ou + t.w1_dv * ov, t.w1_du, t.w1_dv};
-    const auto plane = [&](const float f[3]) {
-      // f0 w0 + f1 w1 + f2 (1 - w0 - w1).
-      return Plane{f[2] + (f[0] - f[2]) * w0.value + (f[1] - f[2]) * w1.value,
-                   (f[0] - f[2]) * w0.d_u + (f[1] - f[2]) * w1.d_u,
-                   (f[0] - f[2]) * w0.d_v + (f[1] - f[2]) * w1.d_v};
-    };
-    inv_z = plane(t.inv_z);
-    sx = plane(t.sx);
-    sy = plane(t.sy);
-    source_w = plane(t.source_w);
-    angle = plane(t.angle);
-  }
 };
 
 // Four pixels of a row side by side, in GCC / Clang vector extensions (SSE on x86-64, NEON on
@@ -129,46 +50,76 @@ inline int LaneBits(I4 mask) {
 #endif
 }
 
-// A triangle's attributes at four pixels: depth, source position relative to the block's
-// first corner, ray angle; `front`: in front of the camera (always, for background).
-struct Lanes {
-  F4 z, fx, fy, angle;
-  I4 front;
-};
+// A textured block's map from target pixels to its source square: the projective map
+// (homography) that takes the target positions of its corners a, b, c, d to source (0, 0),
+// (side, 0), (0, side), (side, side) relative to a. Exact on a plane (two pinhole images of a
+// plane are related by a homography); on a curved block exact at the corners, and an edge
+// shared with the next block is the same target line mapped to the same source line in both,
+// so their inside tests agree. Attributes are bilinear in the source position, inverse depth
+// as w times a bilinear factor, exact on a plane (there w is target over source depth up to
+// scale, and inverse source depth is affine in the source position). Target positions are
+// relative to a's (small numbers, so float keeps the map exact to ~1e-6 of the block).
+struct BlockMap {
+  // (s, t, w) = row k . (du, dv, 1); the source position relative to a is (s / w, t / w).
+  float s_du, s_dv, t_du, t_dv, w_du, w_dv, w_a;
+  // Bilinear coefficients, value = c[0] + c[1] fx + c[2] fy + c[3] fx fy: inverse depth / w
+  // (surfaces) and ray angle.
+  float inv_z[4], angle[4];
+  float stretch;  // Target pixels per source pixel (area ratio).
 
-// AttributePlanes along one pixel row: value at du = 0 and slope in u.
-struct RowPlanes {
-  float inv_z, sx, sy, source_w, angle;
-  float d_inv_z, d_sx, d_sy, d_source_w, d_angle;
-
-  RowPlanes(const AttributePlanes& p, float dv)
-      : inv_z(p.inv_z.At(0, dv)), sx(p.sx.At(0, dv)), sy(p.sy.At(0, dv)),
-        source_w(p.source_w.At(0, dv)), angle(p.angle.At(0, dv)), d_inv_z(p.inv_z.d_u),
-        d_sx(p.sx.d_u), d_sy(p.sy.d_u), d_source_w(p.source_w.d_u), d_angle(p.angle.d_u) {}
-
-  // Background planes are the attributes themselves (screen-affine); surface planes are
-  // attributes / z, the source position homogeneous (see TriangleSetup).
+  // False unless the target quad a, b, d, c is strictly convex (a plane in front of the
+  // camera always is; a block seen edge-on or folded is not, and is drawn as triangles).
   template <bool kBackground>
-  Lanes At(F4 du) const {
-    Lanes l;
-    if constexpr (kBackground) {
-      l.z = F4{} + WarpBuffer::kBackground;
-      l.fx = sx + du * d_sx;
-      l.fy = sy + du * d_sy;
-      l.angle = F4{};
-      l.front = I4{} - 1;
-    } else {
-      const F4 inv = inv_z + du * d_inv_z;
-      // Lanes behind the camera divide to garbage and are dropped by `front`.
-      l.z = 1.0f / inv;
-      const F4 inv_w = 1.0f / (source_w + du * d_source_w);
-      l.fx = (sx + du * d_sx) * inv_w;
-      l.fy = (sy + du * d_sy) * inv_w;
-      l.angle = (angle + du * d_angle) * l.z;
-      l.front = inv > 0;
+  bool Init(const Corner& a, const Corner& b, const Corner& c, const Corner& d, float side) {
+    const float x1 = b.u - a.u, y1 = b.v - a.v;  // Square corner (1, 0).
+    const float x2 = d.u - a.u, y2 = d.v - a.v;  // (1, 1).
+    const float x3 = c.u - a.u, y3 = c.v - a.v;  // (0, 1).
+    // Turns at a, b, d, c: all of one sign for a convex quad.
+    const float turn_a = x1 * y3 - y1 * x3, turn_b = x1 * (y2 - y1) - y1 * (x2 - x1);
+    const float turn_d = (x2 - x1) * (y3 - y2) - (y2 - y1) * (x3 - x2);
+    const float turn_c = (x3 - x2) * (-y3) - (y3 - y2) * (-x3);
+    const bool positive = turn_a > 0 && turn_b > 0 && turn_d > 0 && turn_c > 0;
+    const bool negative = turn_a < 0 && turn_b < 0 && turn_d < 0 && turn_c < 0;
+    if (!positive && !negative) return false;
+    // The unit square to the quad (Heckbert's square-to-quad): (u, v, w) = A (sigma, tau, 1).
+    const float sum_x = x2 - x1 - x3, sum_y = y2 - y1 - y3;
+    const float dx1 = x1 - x2, dx2 = x3 - x2, dy1 = y1 - y2, dy2 = y3 - y2;
+    const float den = dx1 * dy2 - dx2 * dy1;
+    const float g = (sum_x * dy2 - dx2 * sum_y) / den, h = (dx1 * sum_y - sum_x * dy1) / den;
+    const float a00 = x1 + g * x1, a01 = x3 + h * x3, a10 = y1 + g * y1, a11 = y3 + h * y3;
+    // Its inverse up to scale (the adjugate), signed so that w > 0 inside, the source
+    // position scaled from the unit square to side.
+    float sign = a00 * a11 - a01 * a10 > 0 ? 1.0f : -1.0f;
+    w_a = sign * (a00 * a11 - a01 * a10);
+    w_du = sign * (a10 * h - a11 * g);
+    w_dv = sign * (a01 * g - a00 * h);
+    sign *= side;
+    s_du = sign * a11;
+    s_dv = -sign * a01;
+    t_du = -sign * a10;
+    t_dv = sign * a00;
+    if (!(w_a > 0) || !Finite(w_a) || !Finite(w_du) || !Finite(w_dv) || !Finite(s_du) ||
+        !Finite(s_dv) || !Finite(t_du) || !Finite(t_dv)) {
+      return false;
     }
-    return l;
+    stretch = 0.5f * std::abs(x2 * (y3 - y1) - y2 * (x3 - x1)) / (side * side);
+    const float inv_side = 1.0f / side;
+    const auto bilinear = [&](float va, float vb, float vc, float vd, float out[4]) {
+      out[0] = va;
+      out[1] = (vb - va) * inv_side;
+      out[2] = (vc - va) * inv_side;
+      out[3] = (va - vb - vc + vd) * inv_side * inv_side;
+    };
+    if constexpr (!kBackground) {
+      const auto w_at = [&](float du, float dv) { return w_a + w_du * du + w_dv * dv; };
+      bilinear(a.inv_z / w_a, b.inv_z / w_at(x1, y1), c.inv_z / w_at(x3, y3),
+               d.inv_z / w_at(x2, y2), inv_z);
+      bilinear(a.angle, b.angle, c.angle, d.angle, angle);
+    }
+    return true;
   }
+
+  static F4 Bilinear(const float c[4], F4 fx, F4 fy) { return c[0] + fx * c[1] + fy * (c[2] + fx * c[3]); }
 };
 
 // Writes samples of one source into the target buffer (z-test: nearest surface wins;
@@ -200,52 +151,42 @@ class Rasterizer {
     }
   }
 
-  // Triangles (a, b, c) and (b, d, c) of a square block of `side` x `side` source pixels of one
-  // continuous surface (or of background, kBackground), its colour sampled from the source at
-  // the interpolated source position (so a block larger than one pixel keeps the texture's
-  // detail). Surfaces are perspective-correct, background screen-affine.
+  // A square block of `side` x `side` source pixels of one continuous surface (or of
+  // background, kBackground), corners a (top left), b, c, d (bottom right), its colour sampled
+  // from the source at the position BlockMap gives (so a block larger than one pixel keeps
+  // the texture's detail). Returns false, drawing nothing, where the map is not defined
+  // (BlockMap::Init): the caller draws the block another way.
   //
-  // Drawn by inverse mapping: every pixel of the block's bounding box is mapped through each
-  // triangle to a source position relative to a's, (fx, fy), and the triangle covers the pixel
-  // when that position lies in its half of the source square: fx, fy >= 0 and fx + fy <= side
-  // for the first, fx, fy <= side and fx + fy >= side for the second. That is the barycentric
-  // inside test (source position is affine in the perspective-correct weights), but it needs
-  // no edge setup and runs four pixels at a time. The slack is far above float rounding, so a
-  // centre on an edge shared with the next block is drawn by both, never by neither.
+  // Drawn by inverse mapping: every pixel of the block's bounding box is mapped to a source
+  // position relative to a's, (fx, fy), and the block covers the pixel when that lies in the
+  // source square. That needs no edge setup and runs four pixels at a time. The slack is far
+  // above float rounding, so a centre on an edge shared with the next block is drawn by both,
+  // never by neither.
   template <bool kBackground>
-  void TexturedBlock(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
+  bool TexturedBlock(const Corner& a, const Corner& b, const Corner& c, const Corner& d,
                      float side) {
     Box box;
-    if (!ClipQuad(a, b, c, d, &box)) return;
-    // Source positions relative to a's: the inside tests compare them with 0 and side, where
-    // float keeps them exact to ~1e-7 of the block. (Not by copying the corners: the caller
-    // has just written them field by field, and a copy's wider loads would wait for those
-    // stores to retire, ~5% of a render.)
-    const float source_area2 = side * side;
-    TriangleSetup first, second;
-    const bool valid_1 = first.Init<kBackground>(a, b, c, source_area2, a.sx, a.sy);
-    const bool valid_2 = second.Init<kBackground>(b, d, c, source_area2, a.sx, a.sy);
-    if (!valid_1 && !valid_2) return;
-    const AttributePlanes planes[2] = {AttributePlanes(first, a.u, a.v),
-                                       AttributePlanes(second, a.u, a.v)};
+    if (!ClipQuad(a, b, c, d, &box)) return true;
+    BlockMap map;
+    if (!map.Init<kBackground>(a, b, c, d, side)) return false;
     const float slack = 1e-5f * side;
-    const I4 use_1 = I4{} + (valid_1 ? -1 : 0), use_2 = I4{} + (valid_2 ? -1 : 0);
     const F4 lane = {0.5f, 1.5f, 2.5f, 3.5f};
     for (int y = box.y0; y <= box.y1; ++y) {
       const float dv = static_cast<float>(y) + 0.5f - a.v;
-      const RowPlanes row_1(planes[0], dv), row_2(planes[1], dv);
+      const float s_row = map.s_dv * dv, t_row = map.t_dv * dv, w_row = map.w_a + map.w_dv * dv;
       for (int x = box.x0; x <= box.x1; x += 4) {
         const F4 du = (static_cast<float>(x) - a.u) + lane;
-        const Lanes lanes_1 = row_1.At<kBackground>(du), lanes_2 = row_2.At<kBackground>(du);
-        const I4 in_1 = use_1 & lanes_1.front & (lanes_1.fx >= -slack) & (lanes_1.fy >= -slack) &
-                        (lanes_1.fx + lanes_1.fy <= side + slack);
-        const I4 in_2 = use_2 & lanes_2.front & (lanes_2.fx <= side + slack) &
-                        (lanes_2.fy <= side + slack) & (lanes_2.fx + lanes_2.fy >= side - slack);
-        const int count = std::min(4, box.x1 - x + 1);
-        WriteGroup<kBackground>(Index(x, y), count, in_1, lanes_1, first.stretch, in_2, lanes_2,
-                                second.stretch, a);
+        const F4 w = w_row + du * map.w_du;
+        // Lanes where w <= 0 (beyond the quad's horizon) divide to garbage and are dropped.
+        const F4 inv_w = 1.0f / w;
+        const F4 fx = (s_row + du * map.s_du) * inv_w, fy = (t_row + du * map.t_du) * inv_w;
+        const I4 in = (w > 0) & (fx >= -slack) & (fy >= -slack) & (fx <= side + slack) &
+                      (fy <= side + slack) & (I4{0, 1, 2, 3} < box.x1 - x + 1);
+        if (LaneBits(in) == 0) continue;
+        WriteGroup<kBackground>(Index(x, y), in, fx, fy, w, map, a);
       }
     }
+    return true;
   }
 
   // Directions: screen-affine interpolation (no depth); never covers a surface.
@@ -378,15 +319,12 @@ class Rasterizer {
     return 1.0f / ((angle + angle_epsilon_) * std::max(1.0f, stretch));
   }
 
-  // Writes the lanes of a four-pixel group (target pixels i to i + count - 1 of one row) that
-  // lie in one of a block's two triangles (in_1 / in_2, the first where both: their shared
-  // edge) and pass the z-test: depth and weight for all four at once, then the colour of each
-  // written lane, sampled from the source at its position (relative to corner a's).
+  // Writes the lanes of a four-pixel group (target pixels i to i + 3 of one row) that a
+  // block covers (`in`, at source positions fx, fy relative to corner a's, `w` of its map) and
+  // that pass the z-test: depth and weight for all four at once, then the colour of each
+  // written lane, sampled from the source.
   template <bool kBackground>
-  void WriteGroup(size_t i, int count, I4 in_1, const Lanes& lanes_1, float stretch_1, I4 in_2,
-                  const Lanes& lanes_2, float stretch_2, const Corner& a) {
-    const I4 in = (in_1 | in_2) & (I4{0, 1, 2, 3} < count);
-    if (LaneBits(in) == 0) return;
+  void WriteGroup(size_t i, I4 in, F4 fx, F4 fy, F4 w, const BlockMap& map, const Corner& a) {
     // Four depths even where fewer pixels are left in the row: the buffer is padded, and
     // lanes not written are stored back unchanged.
     const F4 depth = Load4(depth_ + i);
@@ -397,18 +335,19 @@ class Rasterizer {
       angle = F4{};
       write = in & (depth == 0);
     } else {
-      z = in_1 ? lanes_1.z : lanes_2.z;
-      angle = in_1 ? lanes_1.angle : lanes_2.angle;
-      // In front of the camera (Lanes::front), so finite is z <= max; NaN fails both tests.
-      write = in & ((depth == 0) | (z < depth)) & (z <= kFloatMax);
+      const F4 inv_z = w * BlockMap::Bilinear(map.inv_z, fx, fy);
+      z = 1.0f / inv_z;
+      angle = BlockMap::Bilinear(map.angle, fx, fy);
+      // In front of the camera and finite; NaN fails every test.
+      write = in & (inv_z > 0) & ((depth == 0) | (z < depth)) & (z <= kFloatMax);
     }
     const int bits = LaneBits(write);
     if (bits == 0) return;
     Store4(depth_ + i, write ? z : depth);
-    const F4 stretch = in_1 ? F4{} + stretch_1 : F4{} + stretch_2;
+    const F4 stretch = F4{} + map.stretch;
     const F4 weight = 1.0f / ((angle + angle_epsilon_) * (stretch > 1.0f ? stretch : F4{} + 1.0f));
-    const F4 sx = a.sx + (in_1 ? lanes_1.fx : lanes_2.fx);
-    const F4 sy = a.sy + (in_1 ? lanes_1.fy : lanes_2.fy);
+    const F4 sx = a.sx + fx;
+    const F4 sy = a.sy + fy;
     const Taps taps = TapsAt(sx, sy, stretch);
     for (int k = 0; k < 4; ++k) {
       if ((bits >> k & 1) == 0) continue;
