@@ -37,7 +37,6 @@ struct Vertices {
   PixelArray<float> v;
   PixelArray<float> inv_z;   // 1 / target z; 0 for background.
   PixelArray<float> angle;   // Ray angle, as in WarpBuffer::Weight.
-  PixelArray<float> source_inv_depth;  // 1 / source depth; 0 where depth is 0.
   PixelArray<uint8_t> kind;  // VertexKind.
   size_t capacity = 0;
 };
@@ -117,7 +116,7 @@ struct RowProjection {
 void ProjectSpan(int n, const RowProjection& c, const float* __restrict ray_x,
                  const float* __restrict depth_in, const int32_t* __restrict sky_in,
                  float* __restrict out_u, float* __restrict out_v, float* __restrict out_inv_z,
-                 float* __restrict out_angle, float* __restrict out_source_inv_depth,
+                 float* __restrict out_angle,
                  int32_t* __restrict out_kind) {
   for (int k = 0; k < n; ++k) {
     const float dir0 = ray_x[k] * c.r00 + c.base0;
@@ -153,7 +152,6 @@ void ProjectSpan(int n, const RowProjection& c, const float* __restrict ray_x,
     out_v[k] = v;
     out_inv_z[k] = surface != 0 ? inv_z : 0.0f;
     out_angle[k] = (surface & ok) != 0 ? angle : 0.0f;
-    out_source_inv_depth[k] = surface != 0 ? 1.0f / depth : 0.0f;
     out_kind[k] = ok * (kSky - surface);
   }
 }
@@ -189,7 +187,7 @@ void ProjectRow(const WarpSetup& s, const SourceView& source, const uint8_t* bac
     for (int k = 0; k < n; ++k) sky_in[k] = background != nullptr ? background[i + static_cast<size_t>(k)] : 0;
     ProjectSpan(n, c, ray_x + chunk, source.depth.Values().data() + i, sky_in, out->u.get() + i,
                 out->v.get() + i, out->inv_z.get() + i, out->angle.get() + i,
-                out->source_inv_depth.get() + i, kinds);
+                kinds);
     for (int k = 0; k < n; ++k) out->kind[i + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
   }
 }
@@ -352,16 +350,16 @@ class SourceWarper {
       }
     }
     if (side == 1 || kind == kSky) return kind;
-    const float* inv = vtx_.source_inv_depth.get();
-    const float i00 = inv[Index(x, y)], i10 = inv[Index(x + side, y)];
-    const float i01 = inv[Index(x, y + side)], i11 = inv[Index(x + side, y + side)];
+    // Inverse source depths (all > 0: one continuous surface).
+    const auto inv = [&](int dx, int dy) { return 1.0f / SourceDepth(Index(x + dx, y + dy)); };
+    const float i00 = inv(0, 0), i10 = inv(side, 0), i01 = inv(0, side), i11 = inv(side, side);
     // The centre and the edge midpoints: where a crease through the block shows most.
     const int half = side / 2;
     const float mid_top = 0.5f * (i00 + i10), mid_bottom = 0.5f * (i01 + i11);
     const float mid_left = 0.5f * (i00 + i01), mid_right = 0.5f * (i10 + i11);
     const float centre = 0.5f * (mid_top + mid_bottom);
     const auto off = [&](int dx, int dy, float expected) {
-      return std::abs(inv[Index(x + dx, y + dy)] - expected) > kFlatTolerance * expected;
+      return std::abs(inv(dx, dy) - expected) > kFlatTolerance * expected;
     };
     if (off(half, half, centre) || off(half, 0, mid_top) || off(half, side, mid_bottom) ||
         off(0, half, mid_left) || off(side, half, mid_right)) {
@@ -624,7 +622,6 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
     Allocate(&vertices.v, count);
     Allocate(&vertices.inv_z, count);
     Allocate(&vertices.angle, count);
-    Allocate(&vertices.source_inv_depth, count);
     Allocate(&vertices.kind, count);
     vertices.capacity = count;
   }
