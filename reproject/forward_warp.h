@@ -14,8 +14,9 @@ namespace parallax {
 enum class WarpMethod {
   kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
   kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct; flat
-           // 8x8, 4x4 or 2x2 blocks of one surface (or of background) as one quad, the colour
-           // sampled from the source at the interpolated source position (TextureFilter).
+           // 8x8, 4x4 or 2x2 blocks of one surface (or of background) as one quad through the
+           // projective map of its corners, the colour sampled from the source at the mapped
+           // source position (TextureFilter).
 };
 
 enum class TextureFilter { kAuto, kBicubic };  // See ForwardWarpOptions::texture_filter.

@@ -68,7 +68,7 @@ struct BlockMap {
   float stretch;  // Target pixels per source pixel (area ratio).
 
   // False unless the target quad a, b, d, c is strictly convex (a plane in front of the
-  // camera always is; a block seen edge-on or folded is not, and is drawn as triangles).
+  // camera always is; a block seen edge-on or folded is not, and is drawn in smaller parts).
   template <bool kBackground>
   bool Init(const Corner& a, const Corner& b, const Corner& c, const Corner& d, float side) {
     const float x1 = b.u - a.u, y1 = b.v - a.v;  // Square corner (1, 0).
@@ -119,7 +119,9 @@ struct BlockMap {
     return true;
   }
 
-  static F4 Bilinear(const float c[4], F4 fx, F4 fy) { return c[0] + fx * c[1] + fy * (c[2] + fx * c[3]); }
+  static F4 Interpolate(const float c[4], F4 fx, F4 fy) {
+    return c[0] + fx * c[1] + fy * (c[2] + fx * c[3]);
+  }
 };
 
 // Writes samples of one source into the target buffer (z-test: nearest surface wins;
@@ -335,9 +337,9 @@ class Rasterizer {
       angle = F4{};
       write = in & (depth == 0);
     } else {
-      const F4 inv_z = w * BlockMap::Bilinear(map.inv_z, fx, fy);
+      const F4 inv_z = w * BlockMap::Interpolate(map.inv_z, fx, fy);
       z = 1.0f / inv_z;
-      angle = BlockMap::Bilinear(map.angle, fx, fy);
+      angle = BlockMap::Interpolate(map.angle, fx, fy);
       // In front of the camera and finite; NaN fails every test.
       write = in & (inv_z > 0) & ((depth == 0) | (z < depth)) & (z <= kFloatMax);
     }
@@ -345,7 +347,8 @@ class Rasterizer {
     if (bits == 0) return;
     Store4(depth_ + i, write ? z : depth);
     const F4 stretch = F4{} + map.stretch;
-    const F4 weight = 1.0f / ((angle + angle_epsilon_) * (stretch > 1.0f ? stretch : F4{} + 1.0f));
+    const F4 weight =
+        1.0f / ((angle + angle_epsilon_) * (stretch > 1.0f ? stretch : F4{} + 1.0f));
     const F4 sx = a.sx + fx;
     const F4 sy = a.sy + fy;
     const Taps taps = TapsAt(sx, sy, stretch);
@@ -397,8 +400,8 @@ class Rasterizer {
 
   // Lane k of `taps` into target pixel i.
   void Bilinear(size_t i, const Taps& taps, int k) {
-    const float* t00 = texture_ + 3 * (static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_) +
-                                       static_cast<size_t>(taps.x0[k]));
+    const size_t row = static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_);
+    const float* t00 = texture_ + 3 * (row + static_cast<size_t>(taps.x0[k]));
     const float* t10 = t00 + taps.step_x[k];
     const float* t01 = t00 + taps.step_y[k];
     const float* t11 = t01 + taps.step_x[k];
