@@ -180,7 +180,8 @@ void Bench::Render() {
     std::string warp;
     int sources;
     std::string fill;
-    int hole_sources = 0;  // More sources while holes or surfaces out of view remain (render --hole-sources).
+    // More sources while holes or surfaces out of view remain (render --hole-sources).
+    int hole_sources = 0;
     bool baseline = false;
     std::string texture_filter = "auto";  // render --texture-filter.
   };

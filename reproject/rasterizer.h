@@ -89,15 +89,15 @@ struct BlockMap {
     const float a00 = x1 + g * x1, a01 = x3 + h * x3, a10 = y1 + g * y1, a11 = y3 + h * y3;
     // Its inverse up to scale (the adjugate), signed so that w > 0 inside, the source
     // position scaled from the unit square to side.
-    float sign = a00 * a11 - a01 * a10 > 0 ? 1.0f : -1.0f;
+    const float sign = a00 * a11 - a01 * a10 > 0 ? 1.0f : -1.0f;
     w_a = sign * (a00 * a11 - a01 * a10);
     w_du = sign * (a10 * h - a11 * g);
     w_dv = sign * (a01 * g - a00 * h);
-    sign *= side;
-    s_du = sign * a11;
-    s_dv = -sign * a01;
-    t_du = -sign * a10;
-    t_dv = sign * a00;
+    const float scale = sign * side;
+    s_du = scale * a11;
+    s_dv = -scale * a01;
+    t_du = -scale * a10;
+    t_dv = scale * a00;
     if (!(w_a > 0) || !Finite(w_a) || !Finite(w_du) || !Finite(w_dv) || !Finite(s_du) ||
         !Finite(s_dv) || !Finite(t_du) || !Finite(t_dv)) {
       return false;
@@ -317,7 +317,10 @@ class Rasterizer {
     weight_[i] = Weight(q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch);
   }
 
-  float Weight(float angle, float stretch) const {
+  // WarpBuffer::Weight of samples at ray angle `angle` (a float, or four lanes) and area
+  // ratio `stretch`.
+  template <typename T>
+  T Weight(T angle, float stretch) const {
     return 1.0f / ((angle + angle_epsilon_) * std::max(1.0f, stretch));
   }
 
@@ -346,12 +349,10 @@ class Rasterizer {
     const int bits = LaneBits(write);
     if (bits == 0) return;
     Store4(depth_ + i, write ? z : depth);
-    const F4 stretch = F4{} + map.stretch;
-    const F4 weight =
-        1.0f / ((angle + angle_epsilon_) * (stretch > 1.0f ? stretch : F4{} + 1.0f));
+    const F4 weight = Weight(angle, map.stretch);
     const F4 sx = a.sx + fx;
     const F4 sy = a.sy + fy;
-    const Taps taps = TapsAt(sx, sy, stretch);
+    const Taps taps = TapsAt(sx, sy, map.stretch);
     for (int k = 0; k < 4; ++k) {
       if ((bits >> k & 1) == 0) continue;
       const size_t pixel = i + static_cast<size_t>(k);
@@ -373,12 +374,13 @@ class Rasterizer {
     F4 w00, w10, w01, w11;
   };
 
-  Taps TapsAt(F4 sx, F4 sy, F4 stretch) const {
+  Taps TapsAt(F4 sx, F4 sy, float stretch) const {
     const float last_x = static_cast<float>(texture_width_ - 1);
     const float last_y = static_cast<float>(texture_height_ - 1);
     Taps t;
-    t.bicubic = (stretch > bicubic_min_stretch_) & (sx >= 1.0f) & (sy >= 1.0f) &
-                (sx < last_x - 1.0f) & (sy < last_y - 2.0f);
+    const I4 magnified = I4{} - (stretch > bicubic_min_stretch_ ? 1 : 0);
+    t.bicubic = magnified & (sx >= 1.0f) & (sy >= 1.0f) & (sx < last_x - 1.0f) &
+                (sy < last_y - 2.0f);
     // Clamped to the image (the interpolation can overshoot a corner by a hair; NaN to 0);
     // then non-negative, so truncation is floor.
     sx = sx > 0.0f ? sx : F4{};
