@@ -2,14 +2,77 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "reproject/simd.h"
+
 namespace parallax {
 namespace {
+
+using simd::F4;
+using simd::I4;
+using simd::LaneBits;
+using simd::Load4;
+using simd::Store4;
+
+constexpr float kFloatMax = std::numeric_limits<float>::max();
+
+// The four lanes of v spread over the twelve channels of four interleaved RGB pixels.
+template <typename V>
+void SpreadOverRgb(V v, V out[3]) {
+  out[0] = __builtin_shufflevector(v, v, 0, 0, 0, 1);
+  out[1] = __builtin_shufflevector(v, v, 1, 1, 2, 2);
+  out[2] = __builtin_shufflevector(v, v, 2, 3, 3, 3);
+}
+
+// Adds the samples of one buffer's row that lie within `limit` (0 < depth <= limit) to the
+// sums, four pixels at a time (the row's last width % 4 pixels one at a time). A surface's
+// depth is summed where `front` holds one.
+struct RowSums {
+  const float* front;
+  const float* limit;
+  float* rgb;  // Interleaved.
+  float* depth;
+  float* weight;
+};
+
+void AddSamples(const float* depth, const float* color, const float* weights, size_t width,
+                const RowSums& sums) {
+  size_t x = 0;
+  for (; x + 4 <= width; x += 4) {
+    const F4 d = Load4(depth + x);
+    const I4 take = (d > 0) & (d <= Load4(sums.limit + x));
+    if (LaneBits(take) == 0) continue;
+    // Colour and weight are written only where a sample landed: lanes not taken may hold
+    // anything, and are selected away, never added.
+    const F4 w = take ? Load4(weights + x) : F4{};
+    const I4 surface = Load4(sums.front + x) != WarpBuffer::kBackground;
+    Store4(sums.depth + x, Load4(sums.depth + x) + ((take & surface) ? w * d : F4{}));
+    Store4(sums.weight + x, Load4(sums.weight + x) + w);
+    F4 w_rgb[3];
+    I4 take_rgb[3];
+    SpreadOverRgb(w, w_rgb);
+    SpreadOverRgb(take, take_rgb);
+    for (size_t k = 0; k < 3; ++k) {
+      float* sum = sums.rgb + 3 * x + 4 * k;
+      const F4 added = w_rgb[k] * Load4(color + 3 * x + 4 * k);
+      Store4(sum, Load4(sum) + (take_rgb[k] ? added : F4{}));
+    }
+  }
+  for (; x < width; ++x) {
+    const float d = depth[x];
+    if (!(d > 0 && d <= sums.limit[x])) continue;
+    const float w = weights[x];
+    for (size_t k = 0; k < 3; ++k) sums.rgb[3 * x + k] += w * color[3 * x + k];
+    if (sums.front[x] != WarpBuffer::kBackground) sums.depth[x] += w * d;
+    sums.weight[x] += w;
+  }
+}
 
 // One row of the blend, buffer after buffer (each buffer's row is read as a stream).
 // `scratch` is resized to 8 floats per pixel of the row.
@@ -69,31 +132,48 @@ void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance, in
   // background samples (nothing else landed there).
   float* limit = any_background + width;
   for (size_t x = 0; x < width; ++x) limit[x] = front[x] * (1.0f + tolerance);
+  const RowSums sums{front, limit, rgb_sum, depth_sum, weight};
   for (const WarpBuffer& buffer : buffers) {
-    const float* depth = buffer.Depths() + row;
-    for (size_t x = 0; x < width; ++x) {
-      const float d = depth[x];
-      if (!(d > 0 && d <= limit[x])) continue;
-      const bool surface = front[x] != WarpBuffer::kBackground;
-      const float w = buffer.Weight(row + x);
-      const float* color = buffer.Color(row + x);
-      for (int k = 0; k < 3; ++k) rgb_sum[3 * x + static_cast<size_t>(k)] += w * color[k];
-      if (surface) depth_sum[x] += w * d;
-      weight[x] += w;
-    }
+    AddSamples(buffer.Depths() + row, buffer.Color(row), buffer.Weights() + row, width, sums);
   }
   float* rgb_out = out->color.Pixels().data() + 3 * row;
   float* depth_out = out->depth.Values().data() + row;
   SampleKind* kind_out = out->kind.data() + row;
-  for (size_t x = 0; x < width; ++x) {
+  // Every pixel: where something landed the weighted means, elsewhere 0 and kNone. Weights
+  // are positive and finite (angles >= 0, epsilon > 0); guarded anyway so a degenerate
+  // sample can never write NaN.
+  size_t x = 0;
+  for (; x + 4 <= width; x += 4) {
+    const I4 surface = Load4(front + x) != WarpBuffer::kBackground;
+    const F4 w = Load4(weight + x);
+    const I4 blended = (surface | (Load4(any_background + x) != 0.0f)) & (w > 0) & (w <= kFloatMax);
+    const int bits = LaneBits(blended);
+    const F4 inv = 1.0f / w;
+    F4 inv_rgb[3];
+    I4 blended_rgb[3];
+    SpreadOverRgb(inv, inv_rgb);
+    SpreadOverRgb(blended, blended_rgb);
+    for (size_t k = 0; k < 3; ++k) {
+      float* rgb = rgb_out + 3 * x + 4 * k;
+      Store4(rgb, blended_rgb[k] ? Load4(rgb_sum + 3 * x + 4 * k) * inv_rgb[k] : F4{});
+    }
+    Store4(depth_out + x, (blended & surface) ? Load4(depth_sum + x) * inv : F4{});
+    for (size_t k = 0; k < 4; ++k) {
+      kind_out[x + k] = (bits >> k & 1) == 0 ? SampleKind::kNone
+                        : surface[k] != 0    ? SampleKind::kSurface
+                                             : SampleKind::kBackground;
+    }
+  }
+  for (; x < width; ++x) {
     const bool surface = front[x] != WarpBuffer::kBackground;
-    // Weights are positive and finite (angles >= 0, epsilon > 0); guard anyway so a
-    // degenerate sample can never write NaN.
-    if ((!surface && any_background[x] == 0.0f) || !(weight[x] > 0) || !std::isfinite(weight[x])) {
+    if ((!surface && any_background[x] == 0.0f) || !(weight[x] > 0) || !(weight[x] <= kFloatMax)) {
+      for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = 0.0f;
+      depth_out[x] = 0.0f;
+      kind_out[x] = SampleKind::kNone;
       continue;
     }
     const float inv = 1.0f / weight[x];
-    for (int k = 0; k < 3; ++k) rgb_out[3 * x + static_cast<size_t>(k)] = rgb_sum[3 * x + static_cast<size_t>(k)] * inv;
+    for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = rgb_sum[3 * x + k] * inv;
     depth_out[x] = surface ? depth_sum[x] * inv : 0.0f;
     kind_out[x] = surface ? SampleKind::kSurface : SampleKind::kBackground;
   }
@@ -124,9 +204,13 @@ void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, 
                                   std::to_string(buffer.Height()));
     }
   }
-  out->color.Reset(width, height, 3);
-  out->depth.Reset(width, height);
-  out->kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
+  // BlendRow writes every pixel: a frame loop's result of the same size is reused as it is,
+  // without clearing ~5 MB first at 640x480.
+  if (out->color.Width() != width || out->color.Height() != height || out->color.Channels() != 3) {
+    out->color.Reset(width, height, 3);
+  }
+  if (out->depth.Width() != width || out->depth.Height() != height) out->depth.Reset(width, height);
+  out->kind.resize(static_cast<size_t>(width) * static_cast<size_t>(height));
   const float tolerance = static_cast<float>(options.depth_tolerance);
   const int min_support = options.min_support;
   tbb::parallel_for(tbb::blocked_range<int>(0, height, 8), [&](const tbb::blocked_range<int>& rows) {

@@ -106,6 +106,7 @@ class WarpBuffer {
   // float computed by the warp rather than angle and stretch for the blend to combine: 4
   // bytes less per sample to write and read back (the K=4 render core 33.4 -> 31.8 ms).
   float Weight(size_t i) const { return weight_[i]; }
+  const float* Weights() const { return weight_.get(); }  // Size() of them.
 
   float* MutableDepth() { return depth_.get(); }
   float* MutableColor() { return color_.get(); }

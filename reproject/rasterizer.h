@@ -6,15 +6,11 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "core/image.h"
 #include "reproject/forward_warp.h"
+#include "reproject/simd.h"
 
 namespace parallax::warp_internal {
 
@@ -36,19 +32,12 @@ struct Corner {
   float sx, sy;  // Source pixel (column, row) whose centre this is.
 };
 
-// Four pixels of a row side by side, in GCC / Clang vector extensions (SSE on x86-64, NEON on
-// ARM, plain code elsewhere). Comparisons give -1 (true) or 0 per lane.
-using F4 = float __attribute__((vector_size(16)));
-using I4 = int32_t __attribute__((vector_size(16)));
-
-// Bit k set where lane k of a comparison result is true.
-inline int LaneBits(I4 mask) {
-#if defined(__SSE2__)
-  return _mm_movemask_ps(reinterpret_cast<__m128>(mask));
-#else
-  return (mask[0] & 1) | (mask[1] & 2) | (mask[2] & 4) | (mask[3] & 8);
-#endif
-}
+// Four pixels of a row side by side.
+using simd::F4;
+using simd::I4;
+using simd::LaneBits;
+using simd::Load4;
+using simd::Store4;
 
 // A textured block's map from target pixels to its source square: the projective map
 // (homography) that takes the target positions of its corners a, b, c, d to source (0, 0),
@@ -439,14 +428,6 @@ class Rasterizer {
     // The kernel's negative lobes can undershoot below black.
     for (int k = 0; k < 3; ++k) color_[3 * i + k] = std::max(rgb[k], 0.0f);
   }
-
-  // Four floats from anywhere (an RGB pixel and the next pixel's R, four depths).
-  static F4 Load4(const float* p) {
-    F4 value;
-    std::memcpy(&value, p, sizeof(value));
-    return value;
-  }
-  static void Store4(float* p, F4 value) { std::memcpy(p, &value, sizeof(value)); }
 
   static void CatmullRom(float t, float w[4]) {
     const float t2 = t * t, t3 = t2 * t;
