@@ -441,12 +441,11 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
                                 std::to_string(classes.height));
   }
   FillSummary summary;
-  size_t empty = 0;
-  for (PixelClass c : classes.classes) {
-    const bool fillable = IsHole(c) || (options.fill_out_of_view && c == PixelClass::kOutOfView);
-    if (fillable) ++empty;
-  }
-  if (empty == 0) {
+  const std::array<size_t, 5> histogram = CountClasses(classes);
+  const auto number = [&](PixelClass c) { return histogram[static_cast<size_t>(c)]; };
+  const size_t fillable = number(PixelClass::kCrack) + number(PixelClass::kDisocclusion) +
+                          (options.fill_out_of_view ? number(PixelClass::kOutOfView) : 0);
+  if (fillable == 0) {
     summary.skipped = "no holes to fill";
   } else if (options.method == FillMethod::kNone) {
     summary.skipped = "not requested (fill none)";
@@ -455,11 +454,8 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
   } else if (options.method == FillMethod::kInpaint) {
     summary.filled_px = FillInpaint(classes, options, blend);
   }
-  empty = 0;
-  for (PixelClass c : classes.classes) {
-    if (c != PixelClass::kCovered && c != PixelClass::kBackground) ++empty;
-  }
   const size_t total = classes.classes.size();
+  const size_t empty = total - number(PixelClass::kCovered) - number(PixelClass::kBackground);
   const size_t left = empty - std::min(empty, static_cast<size_t>(summary.filled_px));
   summary.hole_ratio_filled = total == 0 ? 0.0 : static_cast<double>(left) / static_cast<double>(total);
   return summary;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -315,17 +316,32 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
   return map;
 }
 
+std::array<size_t, 5> CountClasses(const ClassMap& classes) {
+  // Blocks of 16 KB counted in parallel, a pass per class over a block in L1 (++count[class]
+  // would chain every increment through memory; std::count vectorises).
+  constexpr size_t kBlock = size_t{1} << 14;
+  const size_t count = classes.classes.size();
+  const size_t blocks = (count + kBlock - 1) / kBlock;
+  std::vector<std::array<size_t, 5>> per_block(blocks);
+  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
+    const auto begin = classes.classes.begin() + static_cast<std::ptrdiff_t>(b * kBlock);
+    const auto end = classes.classes.begin() + static_cast<std::ptrdiff_t>(std::min(count, (b + 1) * kBlock));
+    for (size_t c = 0; c < 5; ++c) {
+      per_block[b][c] = static_cast<size_t>(std::count(begin, end, static_cast<PixelClass>(c)));
+    }
+  });
+  std::array<size_t, 5> histogram{};
+  for (const std::array<size_t, 5>& block : per_block) {
+    for (size_t c = 0; c < 5; ++c) histogram[c] += block[c];
+  }
+  return histogram;
+}
+
 HoleMetrics ComputeHoleMetrics(const ClassMap& classes) {
   HoleMetrics metrics;
   const size_t count = classes.classes.size();
   if (count == 0) return metrics;
-  // A pass per class: ++histogram[class] would chain every increment through memory (a
-  // third of the render's classification time at 640x480); std::count vectorises.
-  std::array<size_t, 5> histogram{};
-  for (size_t c = 0; c < histogram.size(); ++c) {
-    histogram[c] = static_cast<size_t>(std::count(classes.classes.begin(), classes.classes.end(),
-                                                  static_cast<PixelClass>(c)));
-  }
+  const std::array<size_t, 5> histogram = CountClasses(classes);
   const double total = static_cast<double>(count);
   metrics.covered_ratio = static_cast<double>(histogram[0]) / total;
   metrics.background_ratio = static_cast<double>(histogram[1]) / total;
@@ -336,12 +352,25 @@ HoleMetrics ComputeHoleMetrics(const ClassMap& classes) {
   if (histogram[3] + histogram[4] == 0) return metrics;
 
   // 8-connected components by flood fill; each pixel is pushed once, so the stack never
-  // outgrows the image.
+  // outgrows the image. The search for the next unseen hole pixel skips eight pixels at a time
+  // where none is a hole (holes are a few percent of the image).
+  static_assert(static_cast<int>(PixelClass::kCrack) == 3 &&
+                static_cast<int>(PixelClass::kDisocclusion) == 4);
   const int width = classes.width, height = classes.height;
+  const uint8_t* bytes = reinterpret_cast<const uint8_t*>(classes.classes.data());
   std::vector<uint8_t> seen(count, 0);
   std::vector<size_t> stack;
-  stack.reserve(count);
   for (size_t start = 0; start < count; ++start) {
+    if (start % 8 == 0 && start + 8 <= count) {
+      uint64_t eight;
+      std::memcpy(&eight, bytes + start, sizeof(eight));
+      // A byte is a hole class (3 or 4, the largest) where adding 125 sets its high bit; the
+      // classes are below 128, so no byte carries into the next.
+      if (((eight + 0x7D7D7D7D7D7D7D7DULL) & 0x8080808080808080ULL) == 0) {
+        start += 7;
+        continue;
+      }
+    }
     if (seen[start] != 0 || !IsHole(classes.classes[start])) continue;
     seen[start] = 1;
     stack.push_back(start);

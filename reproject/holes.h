@@ -1,5 +1,7 @@
 #pragma once
 // Classification of every target pixel after blending, and the hole metrics of DESIGN.md.
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -104,6 +106,9 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
                         const PosedCamera& target, const HoleOptions& options);
 
 HoleMetrics ComputeHoleMetrics(const ClassMap& classes);
+
+// How many pixels have each class, indexed by PixelClass. Parallel.
+std::array<size_t, 5> CountClasses(const ClassMap& classes);
 
 // One-channel image, 1 where the pixel has `pixel_class`, else 0.
 Image ClassMask(const ClassMap& classes, PixelClass pixel_class);
