@@ -18,6 +18,7 @@
 
 #include "reproject/background.h"
 #include "reproject/rasterizer.h"
+#include "reproject/simd.h"
 
 namespace parallax {
 namespace {
@@ -83,24 +84,6 @@ WarpSetup MakeSetup(const SourceView& source, const PosedCamera& target,
   setup.max_depth_ratio = static_cast<float>(
       1.0 + slope * std::sqrt(2.0) / std::min(setup.src.fx, setup.src.fy));
   return setup;
-}
-
-// Calls f(x) for every x in [0, count) with marks[x] != 0, eight marks at a time where all
-// are 0 (most are: silhouette and edge vertices are a few percent of a source).
-template <typename F>
-void ForEachMarked(const uint8_t* marks, int count, F&& f) {
-  for (int x = 0; x < count;) {
-    if (x + 8 <= count) {
-      uint64_t eight;
-      std::memcpy(&eight, marks + x, sizeof(eight));
-      if (eight == 0) {
-        x += 8;
-        continue;
-      }
-    }
-    if (marks[x] != 0) f(x);
-    ++x;
-  }
 }
 
 // The per-row constants of ProjectSpan.
@@ -259,7 +242,7 @@ void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penal
   for (int x = 1; x < last; ++x) mark(x, above[x - 1] & above[x] & below[x - 1] & below[x]);
   mark(last, above[last - 1] & below[last - 1]);
   float* angle = vtx->angle.get() + row;
-  ForEachMarked(marks, width, [&](int x) { angle[x] += penalty; });
+  simd::ForEachMarked(marks, width, [&](int x) { angle[x] += penalty; });
 }
 
 class SourceWarper {
@@ -294,7 +277,7 @@ class SourceWarper {
     }
     // In row-major order: z-test ties go the same way on every run.
     for (int y = 0; y < height_; ++y) {
-      ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y, true); });
+      simd::ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y, true); });
     }
   }
 

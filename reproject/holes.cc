@@ -11,6 +11,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "reproject/simd.h"
+
 namespace parallax {
 namespace {
 
@@ -146,15 +148,24 @@ std::vector<DepthRange> RowDepthRanges(const BlendResult& blend) {
   const int width = blend.color.Width(), height = blend.color.Height();
   std::vector<DepthRange> rows(static_cast<size_t>(height));
   tbb::parallel_for(0, height, [&](int y) {
-    DepthRange& range = rows[static_cast<size_t>(y)];
+    const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+    const SampleKind* kind = blend.kind.data() + row;
+    const float* depth = blend.depth.Values().data() + row;
+    // In float and without branches (surface depths are positive and finite).
+    float near = std::numeric_limits<float>::infinity(), far = 0;
+    bool background = false;
     for (int x = 0; x < width; ++x) {
-      const SampleKind kind = blend.Kind(x, y);
-      if (kind == SampleKind::kBackground) range.background = true;
-      if (kind != SampleKind::kSurface) continue;
-      const double depth = blend.depth.At(x, y);
-      range.near = std::min(range.near, depth);
-      range.far = std::max(range.far, depth);
+      const bool surface = kind[x] == SampleKind::kSurface;
+      near = std::min(near, surface ? depth[x] : std::numeric_limits<float>::infinity());
+      far = std::max(far, surface ? depth[x] : 0.0f);
+      background = background || kind[x] == SampleKind::kBackground;
     }
+    DepthRange& range = rows[static_cast<size_t>(y)];
+    if (near <= far) {
+      range.near = near;
+      range.far = far;
+    }
+    range.background = background;
   });
   return rows;
 }
@@ -182,10 +193,8 @@ void MarkCracks(const std::vector<uint8_t>& hole, int width, int height, int rad
   std::vector<uint8_t> eroded(hole.size(), 0);
   const auto for_holes = [&](const auto& body) {
     tbb::parallel_for(0, height, [&](int y) {
-      for (int x = 0; x < width; ++x) {
-        const size_t i = static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x);
-        if (hole[i] != 0) body(x, y, i);
-      }
+      const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+      simd::ForEachMarked(hole.data() + row, width, [&](int x) { body(x, y, row + static_cast<size_t>(x)); });
     });
   };
   for_holes([&](int x, int y, size_t i) {

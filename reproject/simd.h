@@ -1,6 +1,7 @@
 #pragma once
-// Four floats side by side for the per-pixel loops of reproject/ (internal), in GCC / Clang
-// vector extensions: SSE on x86-64, NEON on ARM, plain code elsewhere.
+// Helpers for the per-pixel loops of reproject/ (internal): four floats side by side, in GCC /
+// Clang vector extensions (SSE on x86-64, NEON on ARM, plain code elsewhere), and sparse marks
+// eight at a time.
 #include <cstdint>
 #include <cstring>
 
@@ -30,5 +31,23 @@ inline F4 Load4(const float* p) {
   return value;
 }
 inline void Store4(float* p, F4 value) { std::memcpy(p, &value, sizeof(value)); }
+
+// Calls f(x) for every x in [0, count) with marks[x] != 0, skipping eight marks at a time
+// where all are 0 (for sparse marks: edges, silhouettes, holes).
+template <typename F>
+void ForEachMarked(const uint8_t* marks, int count, F&& f) {
+  for (int x = 0; x < count;) {
+    if (x + 8 <= count) {
+      uint64_t eight;
+      std::memcpy(&eight, marks + x, sizeof(eight));
+      if (eight == 0) {
+        x += 8;
+        continue;
+      }
+    }
+    if (marks[x] != 0) f(x);
+    ++x;
+  }
+}
 
 }  // namespace parallax::simd
