@@ -1,14 +1,16 @@
 // Render timings on example_images/courtyard (640x480, ground-truth depth): a novel view from
 // its K best training views, per warp method, texture filter and fill method; and the same scene at
 // 1920x1080 (every view upsampled 3x, bilinear colour, nearest depth, and cropped to 16:9).
-// The hot loops alone too: one forward warp, the blend of four, classification and filling.
-// Counter: target pixels / s.
+// The hot loops alone too: one forward warp, the blend of four, classification and filling;
+// and the K=4 render on one thread. Counter: target pixels / s.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <vector>
+
+#include <tbb/global_control.h>
 
 #include "core/scene_folder.h"
 #include "reproject/forward_warp.h"
@@ -223,6 +225,13 @@ void BM_ClassifyAndFill(benchmark::State& state) {
   SetPixelRate(state, target);
 }
 
+// The K=4 render on one thread: against BM_Render/mesh_depth_aware/4, how well it uses the
+// two cores.
+void BM_RenderOneThread(benchmark::State& state) {
+  const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  BM_Render(state, WarpMethod::kMesh, FillMethod::kDepthAware);
+}
+
 BENCHMARK(BM_Blend)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ClassifyAndFill)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_ForwardWarp, mesh, WarpMethod::kMesh)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -238,6 +247,7 @@ BENCHMARK_CAPTURE(BM_Render, mesh_no_fill, WarpMethod::kMesh, FillMethod::kNone)
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Render, mesh_inpaint, WarpMethod::kMesh, FillMethod::kInpaint)
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RenderOneThread)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Render, mesh_depth_aware_1920x1080, WarpMethod::kMesh, FillMethod::kDepthAware, true)
     ->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 

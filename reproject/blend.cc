@@ -30,17 +30,18 @@ void SpreadOverRgb(V v, V out[3]) {
   out[2] = __builtin_shufflevector(v, v, 2, 3, 3, 3);
 }
 
-// Adds the samples of one buffer's row that lie within `limit` (0 < depth <= limit) to the
-// sums, four pixels at a time (the row's last width % 4 pixels one at a time). A surface's
-// depth is summed where `front` holds one.
+// The running sums of one row of the blend, and what decides which samples join them.
 struct RowSums {
-  const float* front;
-  const float* limit;
-  float* rgb;  // Interleaved.
+  const float* front;  // Front-most surface depth; +inf: none.
+  const float* limit;  // Samples up to this depth join.
+  float* rgb;          // Interleaved.
   float* depth;
   float* weight;
 };
 
+// Adds the samples of one buffer's row that lie within the limit (0 < depth <= limit) to the
+// sums, four pixels at a time (the row's last width % 4 pixels one at a time); a surface's
+// depth only where the front holds a surface.
 void AddSamples(const float* depth, const float* color, const float* weights, size_t width,
                 const RowSums& sums) {
   size_t x = 0;
