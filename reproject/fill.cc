@@ -441,10 +441,9 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
                                 std::to_string(classes.height));
   }
   FillSummary summary;
-  const std::array<size_t, 5> histogram = CountClasses(classes);
-  const auto number = [&](PixelClass c) { return histogram[static_cast<size_t>(c)]; };
-  const size_t fillable = number(PixelClass::kCrack) + number(PixelClass::kDisocclusion) +
-                          (options.fill_out_of_view ? number(PixelClass::kOutOfView) : 0);
+  const ClassCounts counts = CountClasses(classes);
+  const size_t fillable = counts[PixelClass::kCrack] + counts[PixelClass::kDisocclusion] +
+                          (options.fill_out_of_view ? counts[PixelClass::kOutOfView] : 0);
   if (fillable == 0) {
     summary.skipped = "no holes to fill";
   } else if (options.method == FillMethod::kNone) {
@@ -455,7 +454,7 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
     summary.filled_px = FillInpaint(classes, options, blend);
   }
   const size_t total = classes.classes.size();
-  const size_t empty = total - number(PixelClass::kCovered) - number(PixelClass::kBackground);
+  const size_t empty = total - counts[PixelClass::kCovered] - counts[PixelClass::kBackground];
   const size_t left = empty - std::min(empty, static_cast<size_t>(summary.filled_px));
   summary.hole_ratio_filled = total == 0 ? 0.0 : static_cast<double>(left) / static_cast<double>(total);
   return summary;

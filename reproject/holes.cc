@@ -325,7 +325,8 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
   return map;
 }
 
-std::array<size_t, 5> CountClasses(const ClassMap& classes) {
+ClassCounts CountClasses(const ClassMap& classes) {
+  static_assert(static_cast<size_t>(PixelClass::kDisocclusion) + 1 == kPixelClasses);
   // Blocks counted in parallel, sixteen pixels at a time: per class a vector of sixteen byte
   // counters (a comparison gives -1 per match), emptied before one can overflow.
   using Bytes = uint8_t __attribute__((vector_size(16)));
@@ -334,43 +335,44 @@ std::array<size_t, 5> CountClasses(const ClassMap& classes) {
   const size_t count = classes.classes.size();
   const size_t blocks = (count + kBlock - 1) / kBlock;
   const uint8_t* bytes = reinterpret_cast<const uint8_t*>(classes.classes.data());
-  std::vector<std::array<size_t, 5>> per_block(blocks);
+  std::vector<ClassCounts> per_block(blocks);
   tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
     const size_t begin = b * kBlock, end = std::min(count, begin + kBlock);
-    std::array<size_t, 5>& counts = per_block[b];
-    counts = {};
-    Bytes matches[5] = {};
+    std::array<size_t, kPixelClasses>& counts = per_block[b].pixels;
+    Bytes matches[kPixelClasses] = {};
     size_t i = begin;
     for (; i + 16 <= end; i += 16) {
       Bytes pixels;
       std::memcpy(&pixels, bytes + i, sizeof(pixels));
-      for (uint8_t c = 0; c < 5; ++c) matches[c] -= reinterpret_cast<Bytes>(pixels == c);
+      for (uint8_t c = 0; c < kPixelClasses; ++c) matches[c] -= reinterpret_cast<Bytes>(pixels == c);
     }
-    for (size_t c = 0; c < 5; ++c) {
+    for (size_t c = 0; c < kPixelClasses; ++c) {
       for (size_t k = 0; k < 16; ++k) counts[c] += matches[c][k];
     }
     for (; i < end; ++i) ++counts[bytes[i]];
   });
-  std::array<size_t, 5> histogram{};
-  for (const std::array<size_t, 5>& block : per_block) {
-    for (size_t c = 0; c < 5; ++c) histogram[c] += block[c];
+  ClassCounts total;
+  for (const ClassCounts& block : per_block) {
+    for (size_t c = 0; c < kPixelClasses; ++c) total.pixels[c] += block.pixels[c];
   }
-  return histogram;
+  return total;
 }
 
 HoleMetrics ComputeHoleMetrics(const ClassMap& classes) {
   HoleMetrics metrics;
   const size_t count = classes.classes.size();
   if (count == 0) return metrics;
-  const std::array<size_t, 5> histogram = CountClasses(classes);
-  const double total = static_cast<double>(count);
-  metrics.covered_ratio = static_cast<double>(histogram[0]) / total;
-  metrics.background_ratio = static_cast<double>(histogram[1]) / total;
-  metrics.out_of_view_ratio = static_cast<double>(histogram[2]) / total;
-  metrics.crack_ratio = static_cast<double>(histogram[3]) / total;
-  metrics.disocclusion_ratio = static_cast<double>(histogram[4]) / total;
+  const ClassCounts counts = CountClasses(classes);
+  const auto ratio = [&](PixelClass c) {
+    return static_cast<double>(counts[c]) / static_cast<double>(count);
+  };
+  metrics.covered_ratio = ratio(PixelClass::kCovered);
+  metrics.background_ratio = ratio(PixelClass::kBackground);
+  metrics.out_of_view_ratio = ratio(PixelClass::kOutOfView);
+  metrics.crack_ratio = ratio(PixelClass::kCrack);
+  metrics.disocclusion_ratio = ratio(PixelClass::kDisocclusion);
   metrics.hole_ratio = metrics.crack_ratio + metrics.disocclusion_ratio;
-  if (histogram[3] + histogram[4] == 0) return metrics;
+  if (counts[PixelClass::kCrack] + counts[PixelClass::kDisocclusion] == 0) return metrics;
 
   // 8-connected components by flood fill; each pixel is pushed once, so the stack never
   // outgrows the image. The search for the next unseen hole pixel skips eight pixels at a time

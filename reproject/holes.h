@@ -23,6 +23,14 @@ enum class PixelClass : uint8_t {
 
 inline bool IsHole(PixelClass c) { return c == PixelClass::kCrack || c == PixelClass::kDisocclusion; }
 
+constexpr size_t kPixelClasses = 5;  // kDisocclusion is the last.
+
+// How many pixels have each class.
+struct ClassCounts {
+  std::array<size_t, kPixelClasses> pixels{};
+  size_t operator[](PixelClass c) const { return pixels[static_cast<size_t>(c)]; }
+};
+
 struct HoleOptions {
   // Hole pixels that a morphological opening with a square of this side removes are cracks
   // (so cracks are at most crack_opening_px - 1 pixels wide); odd, >= 1 (1: no cracks).
@@ -107,8 +115,8 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
 
 HoleMetrics ComputeHoleMetrics(const ClassMap& classes);
 
-// How many pixels have each class, indexed by PixelClass. Parallel.
-std::array<size_t, 5> CountClasses(const ClassMap& classes);
+// Counted in parallel.
+ClassCounts CountClasses(const ClassMap& classes);
 
 // One-channel image, 1 where the pixel has `pixel_class`, else 0.
 Image ClassMask(const ClassMap& classes, PixelClass pixel_class);

@@ -78,8 +78,9 @@ struct BlockMap {
     const float a00 = x1 + g * x1, a01 = x3 + h * x3, a10 = y1 + g * y1, a11 = y3 + h * y3;
     // Its inverse up to scale (the adjugate), signed so that w > 0 inside, the source
     // position scaled from the unit square to side.
-    const float sign = a00 * a11 - a01 * a10 > 0 ? 1.0f : -1.0f;
-    w_a = sign * (a00 * a11 - a01 * a10);
+    const float det = a00 * a11 - a01 * a10;
+    const float sign = det > 0 ? 1.0f : -1.0f;
+    w_a = sign * det;
     w_du = sign * (a10 * h - a11 * g);
     w_dv = sign * (a01 * g - a00 * h);
     const float scale = sign * side;

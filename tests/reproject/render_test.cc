@@ -355,19 +355,21 @@ void RenderAllWays(const std::vector<const SourceView*>& sources, const PosedCam
 // whose classes run through every value: every pixel is counted once, under its class.
 TEST(ClassCount, CountsEveryPixelOnceUnderItsClass) {
   ClassMap map{101, 97, {}, {}};
-  std::array<size_t, 5> expected{};
+  std::array<size_t, kPixelClasses> expected{};
   for (int i = 0; i < map.width * map.height; ++i) {
     // Runs of varying length, so that blocks and vectors start mid-run.
     const auto c = static_cast<size_t>((i / 7 + i / 31) % 5);
     map.classes.push_back(static_cast<PixelClass>(c));
     ++expected[c];
   }
-  EXPECT_EQ(CountClasses(map), expected);
+  EXPECT_EQ(CountClasses(map).pixels, expected);
   // One class everywhere: more matches per counter than a byte holds.
   map.classes.assign(map.classes.size(), PixelClass::kDisocclusion);
-  const std::array<size_t, 5> all = CountClasses(map);
-  EXPECT_EQ(all[4], map.classes.size());
-  EXPECT_EQ(all[0] + all[1] + all[2] + all[3], 0u);
+  const ClassCounts all = CountClasses(map);
+  EXPECT_EQ(all[PixelClass::kDisocclusion], map.classes.size());
+  EXPECT_EQ(all[PixelClass::kCovered] + all[PixelClass::kBackground] +
+                all[PixelClass::kOutOfView] + all[PixelClass::kCrack],
+            0u);
 }
 
 TEST(Render, TargetInsideTheSceneStaysFinite) {
