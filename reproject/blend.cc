@@ -77,7 +77,7 @@ void AddSamples(const float* depth, const float* color, const float* weights, si
 
 // One row of the blend, buffer after buffer (each buffer's row is read as a stream).
 // `scratch` is resized to 8 floats per pixel of the row.
-void BlendRow(const std::vector<WarpBuffer>& buffers, int y, float tolerance, int min_support,
+void BlendRow(std::span<const WarpBuffer> buffers, int y, float tolerance, int min_support,
               std::vector<float>* scratch, BlendResult* out) {
   const size_t width = static_cast<size_t>(out->color.Width());
   const size_t row = static_cast<size_t>(y) * width;
@@ -193,7 +193,7 @@ void BlendOptions::Check() const {
   }
 }
 
-void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, BlendResult* out) {
+void Blend(std::span<const WarpBuffer> buffers, const BlendOptions& options, BlendResult* out) {
   options.Check();
   if (buffers.empty()) throw std::invalid_argument("Blend: no warped sources");
   const int width = buffers.front().Width(), height = buffers.front().Height();

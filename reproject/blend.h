@@ -1,6 +1,7 @@
 #pragma once
 // Blending of several sources' warped samples into one target image.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/depth_map.h"
@@ -48,6 +49,6 @@ struct BlendResult {
 // Background samples are blended only where no surface sample landed. Parallel over rows.
 // Overwrites *out, keeping its memory when large enough (a frame loop reuses one).
 // Throws std::invalid_argument for no buffers or buffers of different sizes.
-void Blend(const std::vector<WarpBuffer>& buffers, const BlendOptions& options, BlendResult* out);
+void Blend(std::span<const WarpBuffer> buffers, const BlendOptions& options, BlendResult* out);
 
 }  // namespace parallax

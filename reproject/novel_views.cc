@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -284,15 +285,14 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     if (pick < 0) break;
     const SourceView& source = library.Load(pick, warp);
     render_start = Clock::now();
-    RenderResult more;
-    renderer.RenderWithOneMore(source, &more);
-    const double unseen_after = UnseenRatio(more);
+    renderer.RenderWithOneMore(source, &view->with_one_more);
+    const double unseen_after = UnseenRatio(view->with_one_more);
     spent += Clock::now() - render_start;
     // Kept only when it shows a tenth of the unseen pixels at least: else it did not see
     // them after all (occluded as well), and the render without it stands.
     if (!(unseen_after < kKeptUnseenShare * unseen)) break;
     chosen.push_back(pick);
-    view->result = std::move(more);
+    std::swap(view->result, view->with_one_more);
     unseen = unseen_after;
   }
   for (int index : chosen) view->sources.push_back(library.Names()[static_cast<size_t>(index)]);

@@ -73,6 +73,9 @@ struct NovelView {
   RenderResult result;
   std::vector<std::string> sources;  // The views it was rendered from, best first.
   double ms = 0;                     // Selection, warping, blending, classification, filling.
+  // RenderNovelView's render with one more source, before it decides whether to keep it (the
+  // two trade places when it does): kept here so that its memory, too, serves every view.
+  RenderResult with_one_more;
 };
 
 // Whether pixel (x, y) of a render is one no source saw that another source might show: a

@@ -1,6 +1,7 @@
 #include "reproject/render.h"
 
 #include <chrono>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -49,8 +50,7 @@ void Renderer::Render(const std::vector<const SourceView*>& sources, const Targe
   Pinhole::From(target.camera);  // Rejects a distorted target before any work.
   sources_ = sources;
   target_ = target;
-  buffers_.resize(sources.size());
-  scratch_.resize(sources.size());
+  KeepBuffers(sources.size());
   // One task per source, taken by whichever thread is free: the default partitioner splits
   // four sources into two fixed pairs in selection order, and the best sources, which cover
   // most of the target, cost the most (K=4: 640x480 29.5 -> 28.8 ms, 1920x1080 229 -> 220 ms,
@@ -70,18 +70,24 @@ void Renderer::RenderWithOneMore(const SourceView& source, RenderResult* result)
   const Clock::time_point start = Clock::now();
   if (sources_.empty()) throw std::logic_error("Renderer::RenderWithOneMore before Render");
   CheckSourceView(source);
-  buffers_.resize(sources_.size() + 1);
-  scratch_.resize(sources_.size() + 1);
-  ForwardWarp(source, target_, options_.warp, &buffers_.back(), &scratch_.back());
+  const size_t added = sources_.size();
+  KeepBuffers(added + 1);
+  ForwardWarp(source, target_, options_.warp, &buffers_[added], &scratch_[added]);
   sources_.push_back(&source);  // Only once warped: a throw leaves the last render's state.
   Finish(start, MsSince(start), result);
+}
+
+void Renderer::KeepBuffers(size_t count) {
+  if (buffers_.size() >= count) return;
+  buffers_.resize(count);
+  scratch_.resize(count);
 }
 
 void Renderer::Finish(Clock::time_point start, double warp_ms, RenderResult* result) {
   RenderTimings timings;
   timings.warp_ms = warp_ms;
   Clock::time_point step = Clock::now();
-  Blend(buffers_, options_.blend, &blend_);
+  Blend(std::span<const WarpBuffer>(buffers_).first(sources_.size()), options_.blend, &blend_);
   timings.blend_ms = MsSince(step);
 
   step = Clock::now();

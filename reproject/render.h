@@ -67,7 +67,14 @@ class Renderer {
   // began.
   void Finish(std::chrono::steady_clock::time_point start, double warp_ms, RenderResult* result);
 
+  // Makes at least `count` buffers and scratches; never fewer than before: a novel view that
+  // adds hole sources (RenderWithOneMore) and the next view's Render with fewer sources would
+  // otherwise free the extra ones and allocate and page-fault them again (~11 MB per source at
+  // 640x480).
+  void KeepBuffers(size_t count);
+
   RenderOptions options_;
+  // The first sources_.size() hold the last render's warps.
   std::vector<WarpBuffer> buffers_;
   std::vector<WarpScratch> scratch_;
   std::vector<const SourceView*> sources_;  // Of the last render.

@@ -214,6 +214,17 @@ TEST(Renderer, RenderWithOneMoreEqualsRenderingAllSources) {
   EXPECT_EQ(added.color.Pixels(), all.color.Pixels());
   EXPECT_EQ(added.depth.Values(), all.depth.Values());
   EXPECT_EQ(added.metrics.hole_ratio, all.metrics.hole_ratio);
+
+  // The renderer keeps the added source's buffer for the next view: a render from fewer
+  // sources must not blend it in, and adding the source again must warp it afresh.
+  RenderResult two;
+  renderer.Render({&left, &right}, target, &two);
+  const RenderResult fresh = Render({&left, &right}, target, Options(WarpMethod::kMesh, FillMethod::kDepthAware));
+  EXPECT_EQ(two.color.Pixels(), fresh.color.Pixels());
+  EXPECT_EQ(two.metrics.hole_ratio, fresh.metrics.hole_ratio);
+  EXPECT_NE(two.metrics.hole_ratio, all.metrics.hole_ratio);  // "up" makes a difference.
+  renderer.RenderWithOneMore(up, &two);
+  EXPECT_EQ(two.color.Pixels(), all.color.Pixels());
 }
 
 // A camera path renders into one result, whose memory each frame reuses: nothing of an
