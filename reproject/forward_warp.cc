@@ -48,7 +48,9 @@ struct WarpScratch::Data {
   std::vector<uint8_t> background;  // MarkBackground, when the source has none to share.
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
-  std::vector<uint8_t> edge;        // Mesh: per vertex, 1 when it is to be splatted.
+  // Mesh: per band of target rows, per vertex, 1 when it is to be splatted (every band walks
+  // the whole mesh and marks the same vertices).
+  std::vector<std::vector<uint8_t>> edges;
   std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
   std::vector<uint8_t> silhouette_marks;  // Mesh: PenaliseSilhouetteRow's, one row.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
@@ -551,12 +553,12 @@ void WarpBuffer::Reset(int width, int height) {
   height_ = height;
   const size_t count = Size();
   if (count > capacity_) {
-    Allocate(&depth_, count + kPadding);
+    Allocate(&depth_, count);
     Allocate(&color_, 3 * count);
     Allocate(&weight_, count);
     capacity_ = count;
   }
-  std::fill(depth_.get(), depth_.get() + count + kPadding, 0.0f);
+  std::fill(depth_.get(), depth_.get() + count, 0.0f);
 }
 
 WarpScratch::WarpScratch() : data_(std::make_unique<Data>()) {}
@@ -576,7 +578,8 @@ void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options)
 }
 
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
-                 const ForwardWarpOptions& options, WarpBuffer* buffer, WarpScratch* scratch) {
+                 const ForwardWarpOptions& options, WarpBuffer* buffer, WarpScratch* scratch,
+                 int bands) {
   options.Check();
   CheckSourceView(source);
   WarpScratch local;
@@ -617,10 +620,19 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
     }
   });
 
-  // Rasterisation of one source is serial: triangles from anywhere in the source can land on
-  // any target pixel. Sources run in parallel into their own buffers (see Render).
-  Rasterizer raster(buffer, source.color, options);
-  SourceWarper warper(source, setup, vertices, options, &raster);
+  // Triangles from anywhere in the source can land on any target pixel: each band of target
+  // rows walks the whole mesh (or every splat) and draws what lands in its rows, in the same
+  // order as one band would (the same z-test ties, the same output).
+  const int band_count = std::clamp(bands, 1, std::max(1, setup.dst.height));
+  const auto draw_bands = [&](const auto& draw) {
+    tbb::parallel_for(0, band_count, [&](int band) {
+      const int rows = setup.dst.height;
+      Rasterizer raster(buffer, source.color, options, band * rows / band_count,
+                        (band + 1) * rows / band_count);
+      SourceWarper warper(source, setup, vertices, options, &raster);
+      draw(band, warper);
+    });
+  };
   if (options.method == WarpMethod::kMesh) {
     data.continuous.resize(count);
     tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
@@ -638,9 +650,12 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
                               data.silhouette_marks.data(), &vertices);
       }
     }
-    warper.Mesh(data.continuous, &data.edge);
+    if (data.edges.size() < static_cast<size_t>(band_count)) data.edges.resize(static_cast<size_t>(band_count));
+    draw_bands([&](int band, SourceWarper& warper) {
+      warper.Mesh(data.continuous, &data.edges[static_cast<size_t>(band)]);
+    });
   } else {
-    warper.Splats();
+    draw_bands([](int, SourceWarper& warper) { warper.Splats(); });
   }
 }
 

@@ -113,10 +113,6 @@ class WarpBuffer {
   float* MutableWeight() { return weight_.get(); }
 
  private:
-  // Depths past the last pixel, so that the rasteriser can read and write a row's last pixels
-  // four at a time.
-  static constexpr size_t kPadding = 3;
-
   int width_ = 0;
   int height_ = 0;
   size_t capacity_ = 0;
@@ -152,12 +148,14 @@ void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see
 // ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). Projection is
-// parallel over rows (TBB), rasterisation serial (Render warps sources in parallel); both are
-// allocation-free with a reused `scratch`. Throws std::invalid_argument for a non-pinhole
-// camera, mismatched sizes (CheckSourceView) or bad options.
-// `scratch` may be null (then the warp allocates its own).
+// parallel over rows (TBB); rasterisation is serial unless `bands` > 1: then that many bands
+// of target rows are drawn in parallel, each walking the whole source mesh (more work in
+// all, for a warp that runs alone; Render warps several sources in parallel instead), with
+// the same output bit for bit. Allocation-free with a reused `scratch`. Throws
+// std::invalid_argument for a non-pinhole camera, mismatched sizes (CheckSourceView) or bad
+// options. `scratch` may be null (then the warp allocates its own).
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
                  const ForwardWarpOptions& options, WarpBuffer* buffer,
-                 WarpScratch* scratch = nullptr);
+                 WarpScratch* scratch = nullptr, int bands = 1);
 
 }  // namespace parallax

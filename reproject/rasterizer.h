@@ -118,8 +118,13 @@ struct BlockMap {
 // background only where nothing is).
 class Rasterizer {
  public:
-  Rasterizer(WarpBuffer* buffer, const Image& texture, const ForwardWarpOptions& options)
-      : bicubic_min_stretch_(options.texture_filter == TextureFilter::kBicubic ? 0.0f
+  // Draws only target rows [row_begin, row_end): rasterisers of disjoint row bands may share
+  // one buffer from different threads.
+  Rasterizer(WarpBuffer* buffer, const Image& texture, const ForwardWarpOptions& options,
+             int row_begin, int row_end)
+      : row_begin_(row_begin),
+        row_end_(row_end),
+        bicubic_min_stretch_(options.texture_filter == TextureFilter::kBicubic ? 0.0f
                                                                                : kMagnifiedStretch),
         angle_epsilon_(static_cast<float>(options.angle_epsilon_rad)),
         width_(buffer->Width()),
@@ -175,7 +180,7 @@ class Rasterizer {
         const I4 in = (w > 0) & (fx >= -slack) & (fy >= -slack) & (fx <= side + slack) &
                       (fy <= side + slack) & (I4{0, 1, 2, 3} < box.x1 - x + 1);
         if (LaneBits(in) == 0) continue;
-        WriteGroup<kBackground>(Index(x, y), in, fx, fy, w, map, a);
+        WriteGroup<kBackground>(Index(x, y), width_ - x, in, fx, fy, w, map, a);
       }
     }
     return true;
@@ -266,14 +271,15 @@ class Rasterizer {
                 std::max(std::max(a.v, b.v), std::max(c.v, d.v)), box);
   }
 
-  // Pixels whose centres lie in [u0, u1] x [v0, v1], clipped to the image. Coordinates are
-  // clamped as floats before the integer conversion so far-off vertices cannot overflow it.
+  // Pixels whose centres lie in [u0, u1] x [v0, v1], clipped to the image and the rows drawn.
+  // Coordinates are clamped as floats before the integer conversion so far-off vertices
+  // cannot overflow it.
   bool Clip(float u0, float u1, float v0, float v1, Box* box) const {
     const float w = static_cast<float>(width_), h = static_cast<float>(height_);
     box->x0 = std::max(0, CeilClamped(std::clamp(u0 - 0.5f, -1.0f, w)));
     box->x1 = std::min(width_ - 1, FloorClamped(std::clamp(u1 - 0.5f, -1.0f, w)));
-    box->y0 = std::max(0, CeilClamped(std::clamp(v0 - 0.5f, -1.0f, h)));
-    box->y1 = std::min(height_ - 1, FloorClamped(std::clamp(v1 - 0.5f, -1.0f, h)));
+    box->y0 = std::max(row_begin_, CeilClamped(std::clamp(v0 - 0.5f, -1.0f, h)));
+    box->y1 = std::min(row_end_ - 1, FloorClamped(std::clamp(v1 - 0.5f, -1.0f, h)));
     return box->x0 <= box->x1 && box->y0 <= box->y1;
   }
 
@@ -314,15 +320,22 @@ class Rasterizer {
     return 1.0f / ((angle + angle_epsilon_) * std::max(1.0f, stretch));
   }
 
-  // Writes the lanes of a four-pixel group (target pixels i to i + 3 of one row) that a
-  // block covers (`in`, at source positions fx, fy relative to corner a's, `w` of its map) and
-  // that pass the z-test: depth and weight for all four at once, then the colour of each
-  // written lane, sampled from the source.
+  // Writes the lanes of a four-pixel group (target pixels i to i + 3 of one row, `left` of
+  // them before the row ends) that a block covers (`in`, at source positions fx, fy relative
+  // to corner a's, `w` of its map) and that pass the z-test: depth and weight for all four
+  // at once, then the colour of each written lane, sampled from the source.
   template <bool kBackground>
-  void WriteGroup(size_t i, I4 in, F4 fx, F4 fy, F4 w, const BlockMap& map, const Corner& a) {
-    // Four depths even where fewer pixels are left in the row: the buffer is padded, and
-    // lanes not written are stored back unchanged.
-    const F4 depth = Load4(depth_ + i);
+  void WriteGroup(size_t i, int left, I4 in, F4 fx, F4 fy, F4 w, const BlockMap& map,
+                  const Corner& a) {
+    // Four depths at once inside the row, lanes not written stored back unchanged. A group
+    // that runs past the row's end goes lane by lane: the next row may be another thread's.
+    const bool whole = left >= 4;
+    F4 depth{};
+    if (whole) {
+      depth = Load4(depth_ + i);
+    } else {
+      for (int k = 0; k < left; ++k) depth[k] = depth_[i + static_cast<size_t>(k)];
+    }
     F4 z, angle;
     I4 write;
     if constexpr (kBackground) {
@@ -338,7 +351,13 @@ class Rasterizer {
     }
     const int bits = LaneBits(write);
     if (bits == 0) return;
-    Store4(depth_ + i, write ? z : depth);
+    if (whole) {
+      Store4(depth_ + i, write ? z : depth);
+    } else {
+      for (int k = 0; k < left; ++k) {
+        if (bits >> k & 1) depth_[i + static_cast<size_t>(k)] = z[k];
+      }
+    }
     const F4 weight = Weight(angle, map.stretch);
     const F4 sx = a.sx + fx;
     const F4 sy = a.sy + fy;
@@ -441,6 +460,8 @@ class Rasterizer {
   // Target pixels per source pixel above which TextureFilter::kAuto draws a sample bicubic.
   static constexpr float kMagnifiedStretch = 1.5f;
 
+  int row_begin_;  // Target rows drawn.
+  int row_end_;
   float bicubic_min_stretch_;  // Bicubic above this stretch (where inside by a pixel).
   float angle_epsilon_;
   int width_;

@@ -1,5 +1,6 @@
 #include "reproject/render.h"
 
+#include <algorithm>
 #include <chrono>
 #include <span>
 #include <stdexcept>
@@ -9,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 namespace parallax {
 namespace {
@@ -17,6 +19,15 @@ using Clock = std::chrono::steady_clock;
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// Bands of target rows each of `warps` concurrent warps draws in parallel: enough for every
+// thread to have one. A band walks the whole source mesh, so a warp drawn in two bands costs
+// more CPU in all: worth it only where threads would otherwise wait (one source with two
+// threads: the render's hole sources).
+int BandsPerWarp(size_t warps) {
+  const auto threads = static_cast<size_t>(tbb::this_task_arena::max_concurrency());
+  return static_cast<int>(std::max<size_t>(1, threads / std::max<size_t>(1, warps)));
 }
 
 }  // namespace
@@ -59,7 +70,8 @@ void Renderer::Render(const std::vector<const SourceView*>& sources, const Targe
       tbb::blocked_range<size_t>(0, sources.size(), 1),
       [&](const tbb::blocked_range<size_t>& range) {
         for (size_t i = range.begin(); i < range.end(); ++i) {
-          ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i]);
+          ForwardWarp(*sources[i], target, options_.warp, &buffers_[i], &scratch_[i],
+                      BandsPerWarp(sources.size()));
         }
       },
       tbb::simple_partitioner());
@@ -72,7 +84,7 @@ void Renderer::RenderWithOneMore(const SourceView& source, RenderResult* result)
   CheckSourceView(source);
   const size_t added = sources_.size();
   KeepBuffers(added + 1);
-  ForwardWarp(source, target_, options_.warp, &buffers_[added], &scratch_[added]);
+  ForwardWarp(source, target_, options_.warp, &buffers_[added], &scratch_[added], BandsPerWarp(1));
   sources_.push_back(&source);  // Only once warped: a throw leaves the last render's state.
   Finish(start, MsSince(start), result);
 }
