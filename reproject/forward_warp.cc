@@ -650,7 +650,8 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
                               data.silhouette_marks.data(), &vertices);
       }
     }
-    if (data.edges.size() < static_cast<size_t>(band_count)) data.edges.resize(static_cast<size_t>(band_count));
+    const auto edge_arrays = static_cast<size_t>(band_count);
+    if (data.edges.size() < edge_arrays) data.edges.resize(edge_arrays);
     draw_bands([&](int band, SourceWarper& warper) {
       warper.Mesh(data.continuous, &data.edges[static_cast<size_t>(band)]);
     });
