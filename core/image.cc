@@ -85,7 +85,8 @@ Image ReadImage(const fs::path& path) {
   return image;
 }
 
-void WriteImage(const fs::path& path, const Image& image, PixelFormat format) {
+void WriteImage(const fs::path& path, const Image& image, PixelFormat format,
+                PngCompression png) {
   if (image.Empty()) throw std::invalid_argument("WriteImage " + path.string() + ": empty image");
   for (const float value : image.Pixels()) {
     if (!std::isfinite(value)) {
@@ -105,6 +106,7 @@ void WriteImage(const fs::path& path, const Image& image, PixelFormat format) {
       spec.attribute("oiio:UnassociatedAlpha", 1);  // Colour is not premultiplied.
     }
     spec.attribute("compression", "zip");
+    spec.attribute("png:compressionLevel", png == PngCompression::kFast ? 1 : 6);
     SetReproducibleMetadata(spec);
     if (!output->open(temporary.string(), spec) ||
         !output->write_image(OIIO::TypeDesc::FLOAT, image.Pixels().data()) ||

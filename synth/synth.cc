@@ -72,8 +72,9 @@ SynthSummary RenderSceneFolder(const SceneDesc& scene, const std::string& scene_
       for (const ViewDesc& view : *views) {
         progress.Update("render", done, total);
         const RenderedView rendered = tracer.Render(camera, view.cam_from_world);
+        // Small: example scenes are committed (and reproduced byte for byte by a test).
         WriteImage(paths.images / view.name, EncodeForDisplay(rendered.color),
-                   PixelFormat::kUint8);
+                   PixelFormat::kUint8, PngCompression::kSmall);
         WriteDepthExr(paths.DepthFor(view.name), rendered.depth);
         if (scene.write_normals) {
           WriteImage(paths.NormalFor(view.name), rendered.normal, PixelFormat::kHalf);
