@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -16,11 +15,10 @@ namespace {
 
 using simd::F4;
 using simd::I4;
+using simd::kFloatMax;
 using simd::LaneBits;
 using simd::Load4;
 using simd::Store4;
-
-constexpr float kFloatMax = std::numeric_limits<float>::max();
 
 // The four lanes of v spread over the twelve channels of four interleaved RGB pixels.
 template <typename V>

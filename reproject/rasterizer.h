@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 
 #include "core/image.h"
 #include "reproject/forward_warp.h"
@@ -14,7 +13,7 @@
 
 namespace parallax::warp_internal {
 
-constexpr float kFloatMax = std::numeric_limits<float>::max();
+using simd::kFloatMax;
 inline bool Finite(float value) { return std::abs(value) <= kFloatMax; }
 
 // floor and ceil for values >= -1 by truncation: std::floor is a library call without SSE4.1,

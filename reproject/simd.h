@@ -4,12 +4,16 @@
 // eight at a time.
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
 namespace parallax::simd {
+
+// The largest finite float: `value <= kFloatMax` is false for +inf and NaN, lane by lane too.
+constexpr float kFloatMax = std::numeric_limits<float>::max();
 
 // Comparisons give -1 (true) or 0 per lane.
 using F4 = float __attribute__((vector_size(16)));
