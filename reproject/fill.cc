@@ -135,11 +135,7 @@ class DepthAwareFiller {
       : blend_(*blend), sky_(sky), width_(blend->color.Width()), height_(blend->color.Height()),
         count_(options.directions), tolerance_(static_cast<float>(options.background_tolerance)),
         hole_sky_directions_(static_cast<int>(std::ceil(options.hole_sky_share * count_))) {
-    for (int k = 0; k < count_; ++k) {
-      const double angle = 2 * kPi * k / count_;
-      dir_[static_cast<size_t>(k)] = {static_cast<float>(std::cos(angle)),
-                                      static_cast<float>(std::sin(angle))};
-    }
+    MeasureSteps();
     MeasureDistances();
   }
 
@@ -228,6 +224,10 @@ class DepthAwareFiller {
   }
 
  private:
+  struct Step {
+    int dx, dy;  // Pixel offset.
+  };
+
   size_t Index(int x, int y) const {
     return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
   }
@@ -245,18 +245,14 @@ class DepthAwareFiller {
     const size_t column = static_cast<size_t>(x);
     if (k == 0) return InRow(x, y, row.right[column], out);
     if (2 * k == count_) return InRow(x, y, row.left[column], out);
-    return March(x, y, dir_[static_cast<size_t>(k)], out);
+    return March(x, y, &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)], out);
   }
 
-  bool March(int x, int y, const std::array<float, 2>& dir, Candidate* out) const {
-    const float px = static_cast<float>(x) + 0.5f, py = static_cast<float>(y) + 0.5f;
-    const float width = static_cast<float>(width_), height = static_cast<float>(height_);
-    for (int step = 1;; ++step) {
-      const float s = static_cast<float>(step);
-      const float qx = px + s * dir[0], qy = py + s * dir[1];
-      if (!(qx >= 0 && qy >= 0 && qx < width && qy < height)) return false;
-      // Non-negative here, so truncation is floor (std::floor is a library call).
-      const int ix = static_cast<int>(qx), iy = static_cast<int>(qy);
+  // `steps`: the direction's pixel offsets (MeasureSteps).
+  bool March(int x, int y, const Step* steps, Candidate* out) const {
+    for (int step = 1; step < max_steps_; ++step) {
+      const int ix = x + steps[step].dx, iy = y + steps[step].dy;
+      if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return false;
       const size_t j = Index(ix, iy);
       const SampleKind kind = blend_.kind[j];
       if (kind == SampleKind::kNone) {
@@ -267,9 +263,10 @@ class DepthAwareFiller {
         if (distance > 1) step += kBlock * distance - 5;
         continue;
       }
-      CandidateAt(j, s, out);
+      CandidateAt(j, static_cast<float>(step), out);
       return true;
     }
+    return false;  // Past the last step, outside the image from any pixel.
   }
 
   // The sample at `column` of row y as the candidate of a march along the row from x; false
@@ -286,6 +283,26 @@ class DepthAwareFiller {
                                                            : blend_.depth.Values()[j];
     out->distance_px = distance_px;
     out->rgb = blend_.color.Pixels().data() + 3 * j;
+  }
+
+  // steps_: per direction k, the pixel reached after s steps of one pixel from a pixel's
+  // centre, as an offset from the pixel: (floor(0.5 + s cos), floor(0.5 + s sin)), the same
+  // from every pixel. A march then reads a table instead of stepping in float. After
+  // max_steps_ steps a march has left the image whichever pixel it started from (every
+  // direction moves at least cos(45 deg) of a pixel per step along one axis).
+  void MeasureSteps() {
+    max_steps_ = static_cast<int>(std::ceil(std::max(width_, height_) * std::sqrt(2.0))) + 2;
+    steps_.resize(static_cast<size_t>(count_) * static_cast<size_t>(max_steps_));
+    for (int k = 0; k < count_; ++k) {
+      const double angle = 2 * kPi * k / count_;
+      const auto dx = static_cast<float>(std::cos(angle)), dy = static_cast<float>(std::sin(angle));
+      Step* steps = &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)];
+      for (int s = 0; s < max_steps_; ++s) {
+        const auto fs = static_cast<float>(s);
+        steps[s] = {static_cast<int>(std::floor(0.5f + fs * dx)),
+                    static_cast<int>(std::floor(0.5f + fs * dy))};
+      }
+    }
   }
 
   size_t BlockIndex(int bx, int by) const {
@@ -339,7 +356,8 @@ class DepthAwareFiller {
   int count_;
   float tolerance_;
   int hole_sky_directions_;
-  std::array<std::array<float, 2>, kMaxDirections> dir_{};
+  int max_steps_ = 0;
+  std::vector<Step> steps_;
   int blocks_x_ = 0;
   std::vector<uint16_t> distance_;
 };
