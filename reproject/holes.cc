@@ -83,9 +83,8 @@ inline PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir,
   // The point scaled by inv_depth: the same pixel, and z / depth = p.z().
   const Eigen::Vector3d p = s.origin * inv_depth + dir;
   if (!(p.z() > 0)) return PointView::kOutside;
-  const double inv_z = 1 / p.z();
-  const double u = s.pinhole.fx * p.x() * inv_z + s.pinhole.cx;
-  const double v = s.pinhole.fy * p.y() * inv_z + s.pinhole.cy;
+  const double u = s.pinhole.fx * p.x() / p.z() + s.pinhole.cx;
+  const double v = s.pinhole.fy * p.y() / p.z() + s.pinhole.cy;
   if (!(u >= 0 && v >= 0 && u < s.pinhole.width && v < s.pinhole.height)) {
     return PointView::kOutside;
   }
