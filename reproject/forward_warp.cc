@@ -246,6 +246,80 @@ void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penal
   simd::ForEachMarked(marks, width, [&](int x) { angle[x] += penalty; });
 }
 
+// Every source row mapped into the target, parallel over rows.
+void ProjectAll(const WarpSetup& s, const SourceView& source, const uint8_t* background,
+                WarpScratch::Data* data) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, s.src.height, 16), [&](const tbb::blocked_range<int>& rows) {
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      ProjectRow(s, source, background, data->ray_x.data(), y, &data->vertices);
+    }
+  });
+}
+
+// The per-row data a mesh reads (ProjectRow's vertices, ContinuousRow's quads, the
+// silhouette penalties), prepared either all at once, parallel over rows, or in source row
+// order as the mesh walk reaches it: a warp that runs alone on its thread then reads each row
+// back from cache right after writing it, where a whole source prepared up front (~5 MB of
+// vertices at 640x480) is read back from memory, out of a cache that the other threads' warps
+// share.
+class MeshRows {
+ public:
+  MeshRows(const WarpSetup& setup, const SourceView& source, const uint8_t* background,
+           const ForwardWarpOptions& options, WarpScratch::Data* data)
+      : s_(setup), source_(source), background_(background),
+        penalty_(static_cast<float>(options.silhouette_angle_rad)), data_(data) {
+    data_->continuous.resize(static_cast<size_t>(s_.src.width) * static_cast<size_t>(s_.src.height));
+    data_->silhouette_marks.resize(static_cast<size_t>(s_.src.width));
+  }
+
+  // Every row, the projection and the quads parallel over rows.
+  void PrepareAll() {
+    const int height = s_.src.height;
+    ProjectAll(s_, source_, background_, data_);
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y < rows.end(); ++y) Quads(y);
+    });
+    // Serial (a nested parallel loop here slowed a K=4 render more): ~2% of a K=4 render,
+    // 640x480 and 1920x1080 alike (A/B against silhouette_angle_rad = 0).
+    for (int y = 0; y < height; ++y) Penalise(y);
+    projected_ = complete_ = height;
+  }
+
+  // Vertex rows up to y (clamped to the image) complete: projected, with the quads below
+  // them and their silhouette penalties.
+  void Through(int y) {
+    const int height = s_.src.height;
+    y = std::min(y, height - 1);
+    for (; complete_ <= y; ++complete_) {
+      // The quads of row r join the kinds of rows r and r + 1; its penalties read quads r - 1 and r.
+      for (; projected_ <= std::min(complete_ + 1, height - 1); ++projected_) Project(projected_);
+      Quads(complete_);
+      Penalise(complete_);
+    }
+  }
+
+ private:
+  void Project(int y) {
+    ProjectRow(s_, source_, background_, data_->ray_x.data(), y, &data_->vertices);
+  }
+  void Quads(int y) {
+    ContinuousRow(source_, s_, data_->vertices, y, data_->continuous.data());
+  }
+  void Penalise(int y) {
+    if (penalty_ <= 0) return;
+    PenaliseSilhouetteRow(s_, data_->continuous.data(), penalty_, y,
+                          data_->silhouette_marks.data(), &data_->vertices);
+  }
+
+  const WarpSetup& s_;
+  const SourceView& source_;
+  const uint8_t* background_;
+  float penalty_;
+  WarpScratch::Data* data_;
+  int projected_ = 0;  // Rows projected: [0, projected_).
+  int complete_ = 0;   // Rows complete: [0, complete_).
+};
+
 class SourceWarper {
  public:
   SourceWarper(const SourceView& source, const WarpSetup& setup, const Vertices& vertices,
@@ -260,14 +334,18 @@ class SourceWarper {
   // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
   // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
   // source's stride.
-  void Mesh(const std::vector<uint8_t>& continuous, std::vector<uint8_t>* edge_scratch) {
+  // `rows` prepares the rows as the walk reaches them.
+  void Mesh(const std::vector<uint8_t>& continuous, MeshRows* rows,
+            std::vector<uint8_t>* edge_scratch) {
     const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
     continuous_ = continuous.data();
     edge_ = edge_scratch;
     edge_->assign(count, 0);
     for (int y = 0; y + 1 < height_; y += kMaxBlock) {
+      rows->Through(y + kMaxBlock);
       for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
     }
+    rows->Through(height_ - 1);
     for (int x = 0; x < width_; ++x) {
       MarkEdge(Index(x, 0));
       MarkEdge(Index(x, height_ - 1));
@@ -614,11 +692,6 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
   }
   const uint8_t* background =
       data.background_used != nullptr ? data.background_used->data() : nullptr;
-  tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      ProjectRow(setup, source, background, data.ray_x.data(), y, &vertices);
-    }
-  });
 
   // Triangles from anywhere in the source can land on any target pixel: each band of target
   // rows walks the whole mesh (or every splat) and draws what lands in its rows, in the same
@@ -634,28 +707,16 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
     });
   };
   if (options.method == WarpMethod::kMesh) {
-    data.continuous.resize(count);
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
-      for (int y = rows.begin(); y < rows.end(); ++y) {
-        ContinuousRow(source, setup, vertices, y, data.continuous.data());
-      }
-    });
-    const auto penalty = static_cast<float>(options.silhouette_angle_rad);
-    if (penalty > 0) {
-      // Serial (a nested parallel loop here slowed a K=4 render more): ~2% of a K=4 render,
-      // 640x480 and 1920x1080 alike (A/B against silhouette_angle_rad = 0).
-      data.silhouette_marks.resize(static_cast<size_t>(width));
-      for (int y = 0; y < height; ++y) {
-        PenaliseSilhouetteRow(setup, data.continuous.data(), penalty, y,
-                              data.silhouette_marks.data(), &vertices);
-      }
-    }
+    // One band prepares the rows as it walks them; several bands share rows prepared first.
+    MeshRows rows(setup, source, background, options, &data);
+    if (band_count > 1) rows.PrepareAll();
     const auto edge_arrays = static_cast<size_t>(band_count);
     if (data.edges.size() < edge_arrays) data.edges.resize(edge_arrays);
     draw_bands([&](int band, SourceWarper& warper) {
-      warper.Mesh(data.continuous, &data.edges[static_cast<size_t>(band)]);
+      warper.Mesh(data.continuous, &rows, &data.edges[static_cast<size_t>(band)]);
     });
   } else {
+    ProjectAll(setup, source, background, &data);
     draw_bands([](int, SourceWarper& warper) { warper.Splats(); });
   }
 }

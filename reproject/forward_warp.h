@@ -147,11 +147,12 @@ void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options 
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see
-// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). Projection is
-// parallel over rows (TBB); rasterisation is serial unless `bands` > 1: then that many bands
-// of target rows are drawn in parallel, each walking the whole source mesh (more work in
-// all, for a warp that runs alone; Render warps several sources in parallel instead), with
-// the same output bit for bit. Allocation-free with a reused `scratch`. Throws
+// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). With one band
+// (`bands` = 1) the warp is serial, the mesh's rows projected as its walk reaches them (for
+// warps that run side by side, one per thread, as Render's do); with `bands` > 1 the
+// projection is parallel over rows (TBB) and that many bands of target rows are drawn in
+// parallel, each walking the whole source mesh (more work in all, for a warp that runs
+// alone), with the same output bit for bit. Splats project parallel over rows either way. Allocation-free with a reused `scratch`. Throws
 // std::invalid_argument for a non-pinhole camera, mismatched sizes (CheckSourceView) or bad
 // options. `scratch` may be null (then the warp allocates its own).
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
