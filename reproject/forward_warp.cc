@@ -33,7 +33,9 @@ enum VertexKind : uint8_t { kInvalid = 0, kSurface = 1, kSky = 2 };
 
 }  // namespace
 
-// Every source pixel centre mapped into the target once; triangles and splats share it.
+// Source pixel centres mapped into the target, each once; triangles and splats share them.
+// A window of consecutive source rows (RowWindow's): source pixel i (row-major index) is at
+// At(i) while its row is in the window.
 struct Vertices {
   PixelArray<float> u;       // Target pixel coordinates.
   PixelArray<float> v;
@@ -41,18 +43,24 @@ struct Vertices {
   PixelArray<float> angle;   // Ray angle, as in WarpBuffer::Weight.
   PixelArray<uint8_t> kind;  // VertexKind.
   size_t capacity = 0;
+  size_t offset = 0;  // Source index of the window's first pixel.
+
+  size_t At(size_t i) const { return i - offset; }
+};
+
+// What each band of a warp prepares and marks for itself (every band walks the whole source).
+struct BandScratch {
+  Vertices vertices;
+  std::vector<uint8_t> continuous;        // Mesh: per quad, its four samples are one surface.
+  std::vector<uint8_t> silhouette_marks;  // Mesh: PenaliseSilhouetteRow's, one row.
+  std::vector<uint8_t> edges;             // Mesh: per vertex, 1 when it is to be splatted.
 };
 
 struct WarpScratch::Data {
-  Vertices vertices;
+  std::vector<BandScratch> bands;
   std::vector<uint8_t> background;  // MarkBackground, when the source has none to share.
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
-  // Mesh: per band of target rows, per vertex, 1 when it is to be splatted (every band walks
-  // the whole mesh and marks the same vertices).
-  std::vector<std::vector<uint8_t>> edges;
-  std::vector<uint8_t> continuous;  // Mesh: per quad, its four samples are one surface.
-  std::vector<uint8_t> silhouette_marks;  // Mesh: PenaliseSilhouetteRow's, one row.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
 };
 
@@ -170,11 +178,12 @@ void ProjectRow(const WarpSetup& s, const SourceView& source, const uint8_t* bac
   for (int chunk = 0; chunk < width; chunk += kChunk) {
     const int n = std::min(width - chunk, kChunk);
     const size_t i = row + static_cast<size_t>(chunk);
+    const size_t o = out->At(i);
     for (int k = 0; k < n; ++k) sky_in[k] = background != nullptr ? background[i + static_cast<size_t>(k)] : 0;
-    ProjectSpan(n, c, ray_x + chunk, source.depth.Values().data() + i, sky_in, out->u.get() + i,
-                out->v.get() + i, out->inv_z.get() + i, out->angle.get() + i,
+    ProjectSpan(n, c, ray_x + chunk, source.depth.Values().data() + i, sky_in, out->u.get() + o,
+                out->v.get() + o, out->inv_z.get() + o, out->angle.get() + o,
                 kinds);
-    for (int k = 0; k < n; ++k) out->kind[i + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
+    for (int k = 0; k < n; ++k) out->kind[o + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
   }
 }
 
@@ -195,7 +204,7 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices&
   // failing the depth test becomes kInvalid by clearing bit 0 (kSky keeps its bit 1).
   const float* __restrict depth = source.depth.Values().data() + row;
   const float* __restrict depth_below = depth + width;
-  const uint8_t* __restrict kind = vtx.kind.get() + row;
+  const uint8_t* __restrict kind = vtx.kind.get() + vtx.At(row);
   const uint8_t* __restrict kind_below = kind + width;
   uint8_t* __restrict quad = out + row;
   const float max_ratio = s.max_depth_ratio;
@@ -233,7 +242,7 @@ void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penal
   // (AND is idempotent). Quad column width - 1 does not exist (ContinuousRow marks it 0).
   const uint8_t* __restrict above = y > 0 ? quads + row - static_cast<size_t>(width) : quads + row;
   const uint8_t* __restrict below = y + 1 < height ? quads + row : above;
-  const uint8_t* __restrict kind = vtx->kind.get() + row;
+  const uint8_t* __restrict kind = vtx->kind.get() + vtx->At(row);
   uint8_t* __restrict marks = marks_row;
   const auto mark = [&](int x, uint8_t quads_joined) {
     marks[x] = static_cast<uint8_t>((quads_joined != kSurface) & (kind[x] == kSurface));
@@ -242,110 +251,151 @@ void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penal
   mark(0, above[0] & below[0]);
   for (int x = 1; x < last; ++x) mark(x, above[x - 1] & above[x] & below[x - 1] & below[x]);
   mark(last, above[last - 1] & below[last - 1]);
-  float* angle = vtx->angle.get() + row;
+  float* angle = vtx->angle.get() + vtx->At(row);
   simd::ForEachMarked(marks, width, [&](int x) { angle[x] += penalty; });
 }
 
-// Every source row mapped into the target, parallel over rows.
-void ProjectAll(const WarpSetup& s, const SourceView& source, const uint8_t* background,
-                WarpScratch::Data* data) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, s.src.height, 16), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y < rows.end(); ++y) {
-      ProjectRow(s, source, background, data->ray_x.data(), y, &data->vertices);
-    }
-  });
+template <typename T>
+void Allocate(PixelArray<T>* array, size_t count) {
+  // Per-pixel arrays of a megabyte and more start on a huge page and are advised to use them
+  // (Linux): a warp writes and reads them scattered across the image, missing the TLB with
+  // 4 KB pages. K=4 render at 1920x1080 ~213 -> ~200 ms (A/B, three rounds); 640x480 the same.
+  constexpr size_t kHugePage = size_t{2} << 20;
+  const size_t bytes = count * sizeof(T);
+  if (bytes < (size_t{1} << 20)) {
+    array->reset(static_cast<T*>(std::malloc(std::max<size_t>(bytes, 1))));
+  } else {
+    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
+    array->reset(static_cast<T*>(std::aligned_alloc(kHugePage, rounded)));
+#if defined(__linux__)
+    if (*array) madvise(array->get(), rounded, MADV_HUGEPAGE);
+#endif
+  }
+  if (!*array) throw std::bad_alloc();
 }
 
-// The per-row data a mesh reads (ProjectRow's vertices, ContinuousRow's quads, the
-// silhouette penalties), prepared either all at once, parallel over rows, or in source row
-// order as the mesh walk reaches it: a warp that runs alone on its thread then reads each row
-// back from cache right after writing it, where a whole source prepared up front (~5 MB of
-// vertices at 640x480) is read back from memory, out of a cache that the other threads' warps
-// share.
-class MeshRows {
+// The side of the largest blocks of the mesh (SourceWarper::Mesh), the grid they start on.
+// 8: courtyard novel views from ground-truth sources 33.52 dB with 4, 8 and 16 alike (when a
+// block was two triangles interpolating the source position affinely, 8 lost 0.13 dB to 4
+// on grazing ground); one 640x480 warp ~6.5 -> ~6.2 ms, K=4 at 1920x1080 ~204 -> ~190 ms.
+constexpr int kMaxBlock = 8;
+
+// A band's vertices (with, for a mesh, the quads and silhouette penalties), prepared in source
+// row order as its walk reaches them, and only the few rows the walk reads at a time kept:
+// they stay in cache, where a whole source's vertices (~5 MB at 640x480), prepared first,
+// came back from memory out of a cache that the other thread's warp shares. K=4 render,
+// 640x480: 19.9 ms with the whole source prepared first, 18.4 prepared in order, 16.5 with
+// this window (1920x1080: 167 -> 137 ms; A/B medians).
+class RowWindow {
  public:
-  MeshRows(const WarpSetup& setup, const SourceView& source, const uint8_t* background,
-           const ForwardWarpOptions& options, WarpScratch::Data* data)
-      : s_(setup), source_(source), background_(background),
-        penalty_(static_cast<float>(options.silhouette_angle_rad)), data_(data) {
-    data_->continuous.resize(static_cast<size_t>(s_.src.width) * static_cast<size_t>(s_.src.height));
-    data_->silhouette_marks.resize(static_cast<size_t>(s_.src.width));
+  // A block row of the mesh reads the vertex rows from the one above it to the one below it
+  // (its splats and the quads of its last row): kMaxBlock + 3.
+  static constexpr int kRows = kMaxBlock + 3;
+
+  RowWindow(const WarpSetup& setup, const SourceView& source, const uint8_t* background,
+            const float* ray_x, const ForwardWarpOptions& options, BandScratch* band)
+      : s_(setup), source_(source), background_(background), ray_x_(ray_x),
+        mesh_(options.method == WarpMethod::kMesh),
+        penalty_(static_cast<float>(options.silhouette_angle_rad)), band_(band) {
+    const auto width = static_cast<size_t>(s_.src.width);
+    Vertices& vertices = band_->vertices;
+    const size_t count = static_cast<size_t>(kRows) * width;
+    if (count > vertices.capacity) {
+      Allocate(&vertices.u, count);
+      Allocate(&vertices.v, count);
+      Allocate(&vertices.inv_z, count);
+      Allocate(&vertices.angle, count);
+      Allocate(&vertices.kind, count);
+      vertices.capacity = count;
+    }
+    vertices.offset = 0;
+    if (mesh_) {
+      band_->continuous.resize(width * static_cast<size_t>(s_.src.height));
+      band_->silhouette_marks.resize(width);
+    }
   }
 
-  // Every row, the projection and the quads parallel over rows.
-  void PrepareAll() {
-    const int height = s_.src.height;
-    ProjectAll(s_, source_, background_, data_);
-    tbb::parallel_for(tbb::blocked_range<int>(0, height, 16), [&](const tbb::blocked_range<int>& rows) {
-      for (int y = rows.begin(); y < rows.end(); ++y) Quads(y);
-    });
-    // Serial (a nested parallel loop here slowed a K=4 render more): ~2% of a K=4 render,
-    // 640x480 and 1920x1080 alike (A/B against silhouette_angle_rad = 0).
-    for (int y = 0; y < height; ++y) Penalise(y);
-    projected_ = complete_ = height;
-  }
+  const Vertices& Get() const { return band_->vertices; }
 
-  // Vertex rows up to y (clamped to the image) complete: projected, with the quads below
-  // them and their silhouette penalties.
-  void Through(int y) {
+  // Vertex rows first to last (clamped to the image) prepared and in the window: projected,
+  // and for a mesh with the quads below them and their silhouette penalties. Rows above
+  // `first` may leave the window. Throws std::logic_error when more rows than kRows are asked
+  // for at once.
+  void Through(int first, int last) {
     const int height = s_.src.height;
-    y = std::min(y, height - 1);
-    for (; complete_ <= y; ++complete_) {
-      // The quads of row r join the kinds of rows r and r + 1; its penalties read quads r - 1 and r.
-      for (; projected_ <= std::min(complete_ + 1, height - 1); ++projected_) Project(projected_);
-      Quads(complete_);
-      Penalise(complete_);
+    last = std::min(last, height - 1);
+    for (; complete_ <= last; ++complete_) {
+      // The quads of row r join the kinds of rows r and r + 1; its penalties read quads
+      // r - 1 and r.
+      for (; projected_ <= std::min(complete_ + 1, height - 1); ++projected_) {
+        if (projected_ - first_ >= kRows) Slide(first);
+        ProjectRow(s_, source_, background_, ray_x_, projected_, &band_->vertices);
+      }
+      if (!mesh_) continue;
+      ContinuousRow(source_, s_, band_->vertices, complete_, band_->continuous.data());
+      if (penalty_ > 0) {
+        PenaliseSilhouetteRow(s_, band_->continuous.data(), penalty_, complete_,
+                              band_->silhouette_marks.data(), &band_->vertices);
+      }
     }
   }
 
  private:
-  void Project(int y) {
-    ProjectRow(s_, source_, background_, data_->ray_x.data(), y, &data_->vertices);
-  }
-  void Quads(int y) {
-    ContinuousRow(source_, s_, data_->vertices, y, data_->continuous.data());
-  }
-  void Penalise(int y) {
-    if (penalty_ <= 0) return;
-    PenaliseSilhouetteRow(s_, data_->continuous.data(), penalty_, y,
-                          data_->silhouette_marks.data(), &data_->vertices);
+  // Moves the projected rows from `first` on to the start of the window.
+  void Slide(int first) {
+    first = std::max(first, first_);
+    if (projected_ - first >= kRows) {
+      throw std::logic_error("RowWindow: more than " + std::to_string(kRows) + " rows at once");
+    }
+    const auto width = static_cast<size_t>(s_.src.width);
+    const size_t from = static_cast<size_t>(first - first_) * width;
+    const size_t kept = static_cast<size_t>(projected_ - first) * width;
+    Vertices& vertices = band_->vertices;
+    const auto slide = [&](auto& array) {
+      std::copy(array.get() + from, array.get() + from + kept, array.get());
+    };
+    slide(vertices.u);
+    slide(vertices.v);
+    slide(vertices.inv_z);
+    slide(vertices.angle);
+    slide(vertices.kind);
+    first_ = first;
+    vertices.offset = static_cast<size_t>(first) * width;
   }
 
   const WarpSetup& s_;
   const SourceView& source_;
   const uint8_t* background_;
+  const float* ray_x_;
+  bool mesh_;
   float penalty_;
-  WarpScratch::Data* data_;
+  BandScratch* band_;
+  int first_ = 0;      // The window's first row.
   int projected_ = 0;  // Rows projected: [0, projected_).
-  int complete_ = 0;   // Rows complete: [0, complete_).
+  int complete_ = 0;   // Rows prepared: [0, complete_).
 };
 
 class SourceWarper {
  public:
-  SourceWarper(const SourceView& source, const WarpSetup& setup, const Vertices& vertices,
+  SourceWarper(const SourceView& source, const WarpSetup& setup, RowWindow* rows,
                const ForwardWarpOptions& options, Rasterizer* raster)
-      : source_(source), s_(setup), vtx_(vertices), options_(options), raster_(raster),
-        width_(setup.src.width), height_(setup.src.height) {}
+      : source_(source), s_(setup), rows_(rows), vtx_(rows->Get()), options_(options),
+        raster_(raster), width_(setup.src.width), height_(setup.src.height) {}
 
   // Blocks of kMaxBlock x kMaxBlock source pixels whose quads all join one surface are drawn
   // as one quad (a plane is exact under perspective, a curved surface within a small fraction
   // of a pixel), others split in four down to single quads: most of the image costs one
   // quad setup per 64 source pixels. Vertices next to a dropped triangle or on the source
-  // border are splatted afterwards: the mesh stops at the last sample centre, half a pixel
-  // short of where the pixel ends. `continuous`: ContinuousRow per quad, row-major with the
-  // source's stride.
-  // `rows` prepares the rows as the walk reaches them.
-  void Mesh(const std::vector<uint8_t>& continuous, MeshRows* rows,
-            std::vector<uint8_t>* edge_scratch) {
+  // border are splatted: the mesh stops at the last sample centre, half a pixel short of
+  // where the pixel ends. Block row by block row, each followed by the splats of the vertex
+  // rows it completed, in row-major order (z-test ties go the same way on every run).
+  // `continuous`: ContinuousRow per quad (row-major with the source's stride), `edges` the
+  // marks, both filled as the walk goes.
+  void Mesh(const uint8_t* continuous, std::vector<uint8_t>* edges) {
     const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
-    continuous_ = continuous.data();
-    edge_ = edge_scratch;
+    continuous_ = continuous;
+    edge_ = edges;
     edge_->assign(count, 0);
-    for (int y = 0; y + 1 < height_; y += kMaxBlock) {
-      rows->Through(y + kMaxBlock);
-      for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
-    }
-    rows->Through(height_ - 1);
     for (int x = 0; x < width_; ++x) {
       MarkEdge(Index(x, 0));
       MarkEdge(Index(x, height_ - 1));
@@ -354,14 +404,23 @@ class SourceWarper {
       MarkEdge(Index(0, y));
       MarkEdge(Index(width_ - 1, y));
     }
-    // In row-major order: z-test ties go the same way on every run.
-    for (int y = 0; y < height_; ++y) {
-      simd::ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y, true); });
+    int splatted = 0;  // Vertex rows [0, splatted) splatted.
+    for (int y = 0; y + 1 < height_; y += kMaxBlock) {
+      rows_->Through(y - 1, y + kMaxBlock);
+      for (int x = 0; x + 1 < width_; x += kMaxBlock) Block(x, y, kMaxBlock);
+      // Every quad on rows up to y + kMaxBlock - 1 is drawn (all of them after the last block
+      // row): their marks are complete.
+      const int complete = y + kMaxBlock + 1 < height_ ? y + kMaxBlock : height_;
+      SplatEdges(splatted, complete);
+      splatted = complete;
     }
+    rows_->Through(splatted - 1, height_ - 1);
+    SplatEdges(splatted, height_);
   }
 
   void Splats() {
     for (int y = 0; y < height_; ++y) {
+      rows_->Through(y - 1, y + 1);
       for (int x = 0; x < width_; ++x) SplatVertex(x, y, false);
     }
   }
@@ -371,6 +430,14 @@ class SourceWarper {
     return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
   }
   float SourceDepth(size_t i) const { return source_.depth.Values()[i]; }
+  uint8_t Kind(size_t i) const { return vtx_.kind[vtx_.At(i)]; }
+
+  // Splats the marked vertices of rows [begin, end) (in the window with the rows beside them).
+  void SplatEdges(int begin, int end) {
+    for (int y = begin; y < end; ++y) {
+      simd::ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y, true); });
+    }
+  }
 
   // A source pixel centre by index and coordinates, kept together: deriving the coordinates
   // from the index would cost two 64-bit divisions per corner.
@@ -381,7 +448,8 @@ class SourceWarper {
   Sample At(int x, int y) const { return {Index(x, y), x, y}; }
 
   Corner CornerAt(const Sample& p) const {
-    return {vtx_.u[p.i], vtx_.v[p.i], vtx_.inv_z[p.i], vtx_.angle[p.i],
+    const size_t v = vtx_.At(p.i);
+    return {vtx_.u[v], vtx_.v[v], vtx_.inv_z[v], vtx_.angle[v],
             source_.color.Pixels().data() + 3 * p.i, static_cast<float>(p.x),
             static_cast<float>(p.y)};
   }
@@ -389,10 +457,6 @@ class SourceWarper {
   // Marks a vertex for splatting.
   void MarkEdge(size_t i) { (*edge_)[i] = 1; }
 
-  // 8: courtyard novel views from ground-truth sources 33.52 dB with 4, 8 and 16 alike (when a
-  // block was two triangles interpolating the source position affinely, 8 lost 0.13 dB to 4
-  // on grazing ground); one 640x480 warp ~6.5 -> ~6.2 ms, K=4 at 1920x1080 ~204 -> ~190 ms.
-  static constexpr int kMaxBlock = 8;
   // Relative inverse-depth deviation from the corners' blend within which a block is flat:
   // its samples land within ~kFlatTolerance x (disparity in pixels) of where they should.
   static constexpr float kFlatTolerance = 1e-3f;
@@ -461,14 +525,14 @@ class SourceWarper {
 
   // Two samples of one surface (or both background).
   bool Continuous(size_t i, size_t j) const {
-    if (vtx_.kind[i] != vtx_.kind[j]) return false;
-    if (vtx_.kind[i] == kSky) return true;
+    if (Kind(i) != Kind(j)) return false;
+    if (Kind(i) == kSky) return true;
     const float a = SourceDepth(i), b = SourceDepth(j);
     return std::max(a, b) <= s_.max_depth_ratio * std::min(a, b);
   }
 
   void Triangle(const Sample& a, const Sample& b, const Sample& c) {
-    const uint8_t ka = vtx_.kind[a.i], kb = vtx_.kind[b.i], kc = vtx_.kind[c.i];
+    const uint8_t ka = Kind(a.i), kb = Kind(b.i), kc = Kind(c.i);
     if (ka == kInvalid && kb == kInvalid && kc == kInvalid) return;
     if (ka == kb && kb == kc) {
       if (ka == kSky) {
@@ -495,8 +559,8 @@ class SourceWarper {
       if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
       const size_t j = Index(nx, ny);
       if (!Continuous(i, j)) continue;
-      d[0] = static_cast<float>(sign) * (vtx_.u[j] - vtx_.u[i]);
-      d[1] = static_cast<float>(sign) * (vtx_.v[j] - vtx_.v[i]);
+      d[0] = static_cast<float>(sign) * (vtx_.u[vtx_.At(j)] - vtx_.u[vtx_.At(i)]);
+      d[1] = static_cast<float>(sign) * (vtx_.v[vtx_.At(j)] - vtx_.v[vtx_.At(i)]);
       return true;
     }
     return false;
@@ -508,7 +572,7 @@ class SourceWarper {
   // 28.42 dB; 28.34 with unknown depth counting as neither), though nothing on the far side
   // of that gap grows to meet it.
   bool Beyond(size_t i, size_t j) const {
-    return vtx_.kind[j] != kSurface || SourceDepth(j) > s_.max_depth_ratio * SourceDepth(i);
+    return Kind(j) != kSurface || SourceDepth(j) > s_.max_depth_ratio * SourceDepth(i);
   }
 
   // The share of its footprint a vertex is splatted with: outline_splat_share on the near
@@ -521,13 +585,13 @@ class SourceWarper {
   // centres).
   float OutlineShare(int x, int y) const {
     const size_t i = Index(x, y);
-    const bool surface = vtx_.kind[i] == kSurface;
+    const bool surface = Kind(i) == kSurface;
     bool near_side = false, far_side = false;
     for (int ny = std::max(0, y - 1); ny <= std::min(height_ - 1, y + 1); ++ny) {
       for (int nx = std::max(0, x - 1); nx <= std::min(width_ - 1, x + 1); ++nx) {
         const size_t j = Index(nx, ny);
         near_side = near_side || (surface && Beyond(i, j));
-        far_side = far_side || (vtx_.kind[j] == kSurface && Beyond(j, i));
+        far_side = far_side || (Kind(j) == kSurface && Beyond(j, i));
       }
     }
     if (near_side == far_side) return 1.0f;
@@ -546,10 +610,10 @@ class SourceWarper {
   // for a mesh's edge vertex, at most max_splat_px across).
   void SplatVertex(int x, int y, bool mesh_edge) {
     const size_t i = Index(x, y);
-    if (vtx_.kind[i] == kInvalid) return;
-    const bool background = vtx_.kind[i] == kSky;
+    if (Kind(i) == kInvalid) return;
+    const bool background = Kind(i) == kSky;
     // Fallback without a neighbour: magnification of a fronto-parallel patch.
-    const float depth_ratio = background ? 1.0f : SourceDepth(i) * vtx_.inv_z[i];
+    const float depth_ratio = background ? 1.0f : SourceDepth(i) * vtx_.inv_z[vtx_.At(i)];
     float du[2] = {static_cast<float>(s_.dst.fx / s_.src.fx) * depth_ratio, 0};
     float dv[2] = {0, static_cast<float>(s_.dst.fy / s_.src.fy) * depth_ratio};
     Derivative(x, y, 1, 0, du);
@@ -569,6 +633,7 @@ class SourceWarper {
 
   const SourceView& source_;
   const WarpSetup& s_;
+  RowWindow* rows_;
   const Vertices& vtx_;
   const ForwardWarpOptions& options_;
   Rasterizer* raster_;
@@ -577,25 +642,6 @@ class SourceWarper {
   const uint8_t* continuous_ = nullptr;
   std::vector<uint8_t>* edge_ = nullptr;
 };
-
-template <typename T>
-void Allocate(PixelArray<T>* array, size_t count) {
-  // Per-pixel arrays of a megabyte and more start on a huge page and are advised to use them
-  // (Linux): a warp writes and reads them scattered across the image, missing the TLB with
-  // 4 KB pages. K=4 render at 1920x1080 ~213 -> ~200 ms (A/B, three rounds); 640x480 the same.
-  constexpr size_t kHugePage = size_t{2} << 20;
-  const size_t bytes = count * sizeof(T);
-  if (bytes < (size_t{1} << 20)) {
-    array->reset(static_cast<T*>(std::malloc(std::max<size_t>(bytes, 1))));
-  } else {
-    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    array->reset(static_cast<T*>(std::aligned_alloc(kHugePage, rounded)));
-#if defined(__linux__)
-    if (*array) madvise(array->get(), rounded, MADV_HUGEPAGE);
-#endif
-  }
-  if (!*array) throw std::bad_alloc();
-}
 
 }  // namespace
 
@@ -681,44 +727,27 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
   for (int x = 0; x < width; ++x) {
     data.ray_x[static_cast<size_t>(x)] = static_cast<float>((x + 0.5 - setup.src.cx) / setup.src.fx);
   }
-  Vertices& vertices = data.vertices;
-  if (count > vertices.capacity) {
-    Allocate(&vertices.u, count);
-    Allocate(&vertices.v, count);
-    Allocate(&vertices.inv_z, count);
-    Allocate(&vertices.angle, count);
-    Allocate(&vertices.kind, count);
-    vertices.capacity = count;
-  }
   const uint8_t* background =
       data.background_used != nullptr ? data.background_used->data() : nullptr;
 
   // Triangles from anywhere in the source can land on any target pixel: each band of target
-  // rows walks the whole mesh (or every splat) and draws what lands in its rows, in the same
-  // order as one band would (the same z-test ties, the same output).
+  // rows walks the whole mesh (or every splat), preparing its own rows, and draws what lands
+  // in its rows, in the same order as one band would (the same z-test ties, the same output).
   const int band_count = std::clamp(bands, 1, std::max(1, setup.dst.height));
-  const auto draw_bands = [&](const auto& draw) {
-    tbb::parallel_for(0, band_count, [&](int band) {
-      const int rows = setup.dst.height;
-      Rasterizer raster(buffer, source.color, options, band * rows / band_count,
-                        (band + 1) * rows / band_count);
-      SourceWarper warper(source, setup, vertices, options, &raster);
-      draw(band, warper);
-    });
-  };
-  if (options.method == WarpMethod::kMesh) {
-    // One band prepares the rows as it walks them; several bands share rows prepared first.
-    MeshRows rows(setup, source, background, options, &data);
-    if (band_count > 1) rows.PrepareAll();
-    const auto edge_arrays = static_cast<size_t>(band_count);
-    if (data.edges.size() < edge_arrays) data.edges.resize(edge_arrays);
-    draw_bands([&](int band, SourceWarper& warper) {
-      warper.Mesh(data.continuous, &rows, &data.edges[static_cast<size_t>(band)]);
-    });
-  } else {
-    ProjectAll(setup, source, background, &data);
-    draw_bands([](int, SourceWarper& warper) { warper.Splats(); });
-  }
+  if (data.bands.size() < static_cast<size_t>(band_count)) data.bands.resize(static_cast<size_t>(band_count));
+  tbb::parallel_for(0, band_count, [&](int band) {
+    BandScratch& own = data.bands[static_cast<size_t>(band)];
+    RowWindow rows(setup, source, background, data.ray_x.data(), options, &own);
+    const int target_rows = setup.dst.height;
+    Rasterizer raster(buffer, source.color, options, band * target_rows / band_count,
+                      (band + 1) * target_rows / band_count);
+    SourceWarper warper(source, setup, &rows, options, &raster);
+    if (options.method == WarpMethod::kMesh) {
+      warper.Mesh(own.continuous.data(), &own.edges);
+    } else {
+      warper.Splats();
+    }
+  });
 }
 
 }  // namespace parallax

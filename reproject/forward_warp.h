@@ -121,8 +121,8 @@ class WarpBuffer {
   PixelArray<float> weight_;
 };
 
-// Per-source-pixel memory a warp needs (projections, masks); keeping one between calls saves
-// allocating and page-faulting ~8 MB per 640x480 source. One per concurrent warp.
+// Memory a warp needs (per band: a window of projected rows, per-pixel masks); keeping one
+// between calls saves allocating and page-faulting it. One per concurrent warp.
 class WarpScratch {
  public:
   WarpScratch();
@@ -147,12 +147,12 @@ void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options 
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see
-// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). With one band
-// (`bands` = 1) the warp is serial, the mesh's rows projected as its walk reaches them (for
-// warps that run side by side, one per thread, as Render's do); with `bands` > 1 the
-// projection is parallel over rows (TBB) and that many bands of target rows are drawn in
-// parallel, each walking the whole source mesh (more work in all, for a warp that runs
-// alone), with the same output bit for bit. Splats project parallel over rows either way. Allocation-free with a reused `scratch`. Throws
+// ForwardWarpOptions::background_at_infinity) or unknown (they land nowhere). The source is
+// projected row by row as the walk over it reaches each row. With one band (`bands` = 1) the
+// warp is serial (for warps that run side by side, one per thread, as Render's do); with
+// `bands` > 1 that many bands of target rows are drawn in parallel (TBB), each walking and
+// projecting the whole source (more work in all, for a warp that runs alone), with the same
+// output bit for bit. Allocation-free with a reused `scratch`. Throws
 // std::invalid_argument for a non-pinhole camera, mismatched sizes (CheckSourceView) or bad
 // options. `scratch` may be null (then the warp allocates its own).
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
