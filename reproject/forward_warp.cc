@@ -42,6 +42,11 @@ struct Vertices {
   PixelArray<float> inv_z;   // 1 / target z; 0 for background.
   PixelArray<float> angle;   // Ray angle, as in WarpBuffer::Weight.
   PixelArray<uint8_t> kind;  // VertexKind.
+  // Mesh: per quad (pixel centres (x, y) to (x + 1, y + 1)), ContinuousRow's.
+  PixelArray<uint8_t> quads;
+  // Mesh: 1 where the vertex is to be splatted (the image border, and beside dropped
+  // triangles).
+  PixelArray<uint8_t> edges;
   size_t capacity = 0;
   size_t offset = 0;  // Source index of the window's first pixel.
 
@@ -51,9 +56,7 @@ struct Vertices {
 // What each band of a warp prepares and marks for itself (every band walks the whole source).
 struct BandScratch {
   Vertices vertices;
-  std::vector<uint8_t> continuous;        // Mesh: per quad, its four samples are one surface.
   std::vector<uint8_t> silhouette_marks;  // Mesh: PenaliseSilhouetteRow's, one row.
-  std::vector<uint8_t> edges;             // Mesh: per vertex, 1 when it is to be splatted.
 };
 
 struct WarpScratch::Data {
@@ -190,12 +193,12 @@ void ProjectRow(const WarpSetup& s, const SourceView& source, const uint8_t* bac
 // Per quad of source row y (pixel centres (x, y) to (x + 1, y + 1)): kSurface when its four
 // samples are surface within max_depth_ratio of each other (one surface), kSky when all four
 // are background, else kInvalid.
-void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices& vtx, int y,
-                   uint8_t* out) {
+void ContinuousRow(const SourceView& source, const WarpSetup& s, int y, Vertices* vtx) {
   const int width = s.src.width;
   const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
+  uint8_t* __restrict quad = vtx->quads.get() + vtx->At(row);
   if (y + 1 >= s.src.height) {
-    std::fill(out + row, out + row + static_cast<size_t>(width), uint8_t{0});
+    std::fill(quad, quad + width, uint8_t{0});
     return;
   }
   // In three passes that each vectorise (a loop mixing float and byte lanes does not, on
@@ -204,9 +207,8 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices&
   // failing the depth test becomes kInvalid by clearing bit 0 (kSky keeps its bit 1).
   const float* __restrict depth = source.depth.Values().data() + row;
   const float* __restrict depth_below = depth + width;
-  const uint8_t* __restrict kind = vtx.kind.get() + vtx.At(row);
+  const uint8_t* __restrict kind = vtx->kind.get() + vtx->At(row);
   const uint8_t* __restrict kind_below = kind + width;
-  uint8_t* __restrict quad = out + row;
   const float max_ratio = s.max_depth_ratio;
   constexpr int kChunk = 64;
   int32_t one_surface[kChunk];
@@ -233,15 +235,16 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, const Vertices&
 // pixels lie on a silhouette, or next to sky or unknown depth, and their photo colour mixes
 // the two sides, where another source that sees the point away from its silhouettes has it
 // pure. Quads outside the image do not count (the image border is no silhouette).
-void PenaliseSilhouetteRow(const WarpSetup& s, const uint8_t* quads, float penalty, int y,
-                           uint8_t* marks_row, Vertices* vtx) {
+void PenaliseSilhouetteRow(const WarpSetup& s, float penalty, int y, uint8_t* marks_row,
+                           Vertices* vtx) {
   const int width = s.src.width, height = s.src.height;
   if (width < 2 || height < 2) return;  // No quads.
   const size_t row = static_cast<size_t>(y) * static_cast<size_t>(width);
   // Quad rows y - 1 and y; the first and the last vertex row have one of them, read twice
   // (AND is idempotent). Quad column width - 1 does not exist (ContinuousRow marks it 0).
-  const uint8_t* __restrict above = y > 0 ? quads + row - static_cast<size_t>(width) : quads + row;
-  const uint8_t* __restrict below = y + 1 < height ? quads + row : above;
+  const uint8_t* quads = vtx->quads.get() + vtx->At(row);
+  const uint8_t* __restrict above = y > 0 ? quads - width : quads;
+  const uint8_t* __restrict below = y + 1 < height ? quads : above;
   const uint8_t* __restrict kind = vtx->kind.get() + vtx->At(row);
   uint8_t* __restrict marks = marks_row;
   const auto mark = [&](int x, uint8_t quads_joined) {
@@ -306,16 +309,15 @@ class RowWindow {
       Allocate(&vertices.inv_z, count);
       Allocate(&vertices.angle, count);
       Allocate(&vertices.kind, count);
+      Allocate(&vertices.quads, count);
+      Allocate(&vertices.edges, count);
       vertices.capacity = count;
     }
     vertices.offset = 0;
-    if (mesh_) {
-      band_->continuous.resize(width * static_cast<size_t>(s_.src.height));
-      band_->silhouette_marks.resize(width);
-    }
+    if (mesh_) band_->silhouette_marks.resize(width);
   }
 
-  const Vertices& Get() const { return band_->vertices; }
+  Vertices& Get() { return band_->vertices; }
 
   // Vertex rows first to last (clamped to the image) prepared and in the window: projected,
   // and for a mesh with the quads below them and their silhouette penalties. Rows above
@@ -330,17 +332,30 @@ class RowWindow {
       for (; projected_ <= std::min(complete_ + 1, height - 1); ++projected_) {
         if (projected_ - first_ >= kRows) Slide(first);
         ProjectRow(s_, source_, background_, ray_x_, projected_, &band_->vertices);
+        if (mesh_) MarkBorder(projected_);
       }
       if (!mesh_) continue;
-      ContinuousRow(source_, s_, band_->vertices, complete_, band_->continuous.data());
+      ContinuousRow(source_, s_, complete_, &band_->vertices);
       if (penalty_ > 0) {
-        PenaliseSilhouetteRow(s_, band_->continuous.data(), penalty_, complete_,
-                              band_->silhouette_marks.data(), &band_->vertices);
+        PenaliseSilhouetteRow(s_, penalty_, complete_, band_->silhouette_marks.data(),
+                              &band_->vertices);
       }
     }
   }
 
  private:
+  // The edge marks of row y: the image border only, so far.
+  void MarkBorder(int y) {
+    const int width = s_.src.width;
+    if (width == 0) return;
+    uint8_t* edges = band_->vertices.edges.get() +
+                     band_->vertices.At(static_cast<size_t>(y) * static_cast<size_t>(width));
+    const bool border_row = y == 0 || y == s_.src.height - 1;
+    std::fill(edges, edges + width, static_cast<uint8_t>(border_row ? 1 : 0));
+    edges[0] = 1;
+    edges[width - 1] = 1;
+  }
+
   // Moves the projected rows from `first` on to the start of the window.
   void Slide(int first) {
     first = std::max(first, first_);
@@ -359,6 +374,8 @@ class RowWindow {
     slide(vertices.inv_z);
     slide(vertices.angle);
     slide(vertices.kind);
+    slide(vertices.quads);
+    slide(vertices.edges);
     first_ = first;
     vertices.offset = static_cast<size_t>(first) * width;
   }
@@ -389,21 +406,7 @@ class SourceWarper {
   // border are splatted: the mesh stops at the last sample centre, half a pixel short of
   // where the pixel ends. Block row by block row, each followed by the splats of the vertex
   // rows it completed, in row-major order (z-test ties go the same way on every run).
-  // `continuous`: ContinuousRow per quad (row-major with the source's stride), `edges` the
-  // marks, both filled as the walk goes.
-  void Mesh(const uint8_t* continuous, std::vector<uint8_t>* edges) {
-    const size_t count = static_cast<size_t>(width_) * static_cast<size_t>(height_);
-    continuous_ = continuous;
-    edge_ = edges;
-    edge_->assign(count, 0);
-    for (int x = 0; x < width_; ++x) {
-      MarkEdge(Index(x, 0));
-      MarkEdge(Index(x, height_ - 1));
-    }
-    for (int y = 0; y < height_; ++y) {
-      MarkEdge(Index(0, y));
-      MarkEdge(Index(width_ - 1, y));
-    }
+  void Mesh() {
     int splatted = 0;  // Vertex rows [0, splatted) splatted.
     for (int y = 0; y + 1 < height_; y += kMaxBlock) {
       rows_->Through(y - 1, y + kMaxBlock);
@@ -435,7 +438,8 @@ class SourceWarper {
   // Splats the marked vertices of rows [begin, end) (in the window with the rows beside them).
   void SplatEdges(int begin, int end) {
     for (int y = begin; y < end; ++y) {
-      simd::ForEachMarked(edge_->data() + Index(0, y), width_, [&](int x) { SplatVertex(x, y, true); });
+      simd::ForEachMarked(vtx_.edges.get() + vtx_.At(Index(0, y)), width_,
+                          [&](int x) { SplatVertex(x, y, true); });
     }
   }
 
@@ -455,7 +459,7 @@ class SourceWarper {
   }
 
   // Marks a vertex for splatting.
-  void MarkEdge(size_t i) { (*edge_)[i] = 1; }
+  void MarkEdge(size_t i) { vtx_.edges[vtx_.At(i)] = 1; }
 
   // Relative inverse-depth deviation from the corners' blend within which a block is flat:
   // its samples land within ~kFlatTolerance x (disparity in pixels) of where they should.
@@ -469,10 +473,10 @@ class SourceWarper {
   // every quad is background. Else kInvalid.
   uint8_t BlockKind(int x, int y, int side) const {
     if (x + side >= width_ || y + side >= height_) return kInvalid;
-    const uint8_t kind = continuous_[Index(x, y)];
+    const uint8_t kind = vtx_.quads[vtx_.At(Index(x, y))];
     if (kind == kInvalid) return kInvalid;
     for (int r = y; r < y + side; ++r) {
-      const uint8_t* row = continuous_ + Index(x, r);
+      const uint8_t* row = vtx_.quads.get() + vtx_.At(Index(x, r));
       for (int c = 0; c < side; ++c) {
         if (row[c] != kind) return kInvalid;
       }
@@ -634,13 +638,11 @@ class SourceWarper {
   const SourceView& source_;
   const WarpSetup& s_;
   RowWindow* rows_;
-  const Vertices& vtx_;
+  Vertices& vtx_;
   const ForwardWarpOptions& options_;
   Rasterizer* raster_;
   int width_;
   int height_;
-  const uint8_t* continuous_ = nullptr;
-  std::vector<uint8_t>* edge_ = nullptr;
 };
 
 }  // namespace
@@ -743,7 +745,7 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
                       (band + 1) * target_rows / band_count);
     SourceWarper warper(source, setup, &rows, options, &raster);
     if (options.method == WarpMethod::kMesh) {
-      warper.Mesh(own.continuous.data(), &own.edges);
+      warper.Mesh();
     } else {
       warper.Splats();
     }
