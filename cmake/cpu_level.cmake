@@ -5,7 +5,8 @@
 # where it is made; OFF builds for any x86-64 CPU (to copy the binaries to an older machine);
 # ON forces it. The rest of parallax stays baseline: `parallax synth` reproduces the committed
 # example scenes byte for byte only without fused multiply-adds.
-set(PARALLAX_X86_64_V3 AUTO CACHE STRING "Compile for x86-64-v3: AUTO (when this machine has it), ON or OFF")
+set(PARALLAX_X86_64_V3 AUTO CACHE STRING
+    "Compile the render core for x86-64-v3: AUTO (when this machine has it), ON or OFF")
 set_property(CACHE PARALLAX_X86_64_V3 PROPERTY STRINGS AUTO ON OFF)
 
 include(CheckCXXCompilerFlag)
@@ -32,4 +33,5 @@ if(parallax_use_v3)
   # baseline x86-64 that hand them over.
   target_compile_definitions(parallax_cpu_level INTERFACE EIGEN_MAX_STATIC_ALIGN_BYTES=16)
 endif()
-message(STATUS "parallax: compiled for x86-64-v3: ${parallax_use_v3} (PARALLAX_X86_64_V3=${PARALLAX_X86_64_V3})")
+message(STATUS "parallax: render core compiled for x86-64-v3: ${parallax_use_v3} "
+               "(PARALLAX_X86_64_V3=${PARALLAX_X86_64_V3})")

@@ -186,7 +186,9 @@ void ProjectRow(const WarpSetup& s, const SourceView& source, const uint8_t* bac
     ProjectSpan(n, c, ray_x + chunk, source.depth.Values().data() + i, sky_in, out->u.get() + o,
                 out->v.get() + o, out->inv_z.get() + o, out->angle.get() + o,
                 kinds);
-    for (int k = 0; k < n; ++k) out->kind[o + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
+    for (int k = 0; k < n; ++k) {
+      out->kind[o + static_cast<size_t>(k)] = static_cast<uint8_t>(kinds[k]);
+    }
   }
 }
 
@@ -736,7 +738,8 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
   // rows walks the whole mesh (or every splat), preparing its own rows, and draws what lands
   // in its rows, in the same order as one band would (the same z-test ties, the same output).
   const int band_count = std::clamp(bands, 1, std::max(1, setup.dst.height));
-  if (data.bands.size() < static_cast<size_t>(band_count)) data.bands.resize(static_cast<size_t>(band_count));
+  const auto band_scratch = static_cast<size_t>(band_count);
+  if (data.bands.size() < band_scratch) data.bands.resize(band_scratch);
   tbb::parallel_for(0, band_count, [&](int band) {
     BandScratch& own = data.bands[static_cast<size_t>(band)];
     RowWindow rows(setup, source, background, data.ray_x.data(), options, &own);
