@@ -150,34 +150,42 @@ class DepthAwareFiller {
     return open_to_sky ? hole_sky_directions_ : count_ + 1;
   }
 
-  // Per column of one row, the nearest column on either side with a sample (-1 and the width
-  // where there is none).
+  // The nearest columns with a sample on either side of a pixel in its row (-1 and the width
+  // where there is none): the marches along the row (directions 0 and pi) become one lookup
+  // each, as the row is walked (FillRow). An out-of-view band across the image left them to
+  // cross it pixel by pixel (the distance field lets no march along the band's edge jump),
+  // 40% of the fill of a view looking up.
   struct RowSamples {
-    std::vector<int> left, right;
+    int left, right;
   };
 
-  // The marches along the row (directions 0 and pi) become one lookup each: an out-of-view
-  // band across the image left them to cross it pixel by pixel (the distance field lets no
-  // march along the band's edge jump), 40% of the fill of a view looking up.
-  void FindRowSamples(int y, RowSamples* row) const {
-    row->left.resize(static_cast<size_t>(width_));
-    row->right.resize(static_cast<size_t>(width_));
+  // Fills the pixels of row y that ShouldFill (they have no sample); returns how many it
+  // filled.
+  int FillRow(const ClassMap& classes, const FillOptions& options, int y) {
     const SampleKind* kind = blend_.kind.data() + Index(0, y);
-    int nearest = -1;
+    RowSamples row{-1, -1};
+    int filled = 0;
     for (int x = 0; x < width_; ++x) {
-      row->left[static_cast<size_t>(x)] = nearest;
-      if (kind[x] != SampleKind::kNone) nearest = x;
+      if (kind[x] != SampleKind::kNone) {
+        row.left = x;
+        continue;
+      }
+      const PixelClass pixel_class = classes.At(x, y);
+      if (!ShouldFill(pixel_class, options)) continue;
+      if (row.right <= x) {  // The first pixel of a run without samples.
+        row.right = x + 1;
+        while (row.right < width_ && kind[row.right] == SampleKind::kNone) ++row.right;
+      }
+      const int sky_directions = SkyDirections(pixel_class, classes.OpenToSky(x, y));
+      if (FillPixel(x, y, sky_directions, row)) ++filled;
     }
-    nearest = width_;
-    for (int x = width_ - 1; x >= 0; --x) {
-      row->right[static_cast<size_t>(x)] = nearest;
-      if (kind[x] != SampleKind::kNone) nearest = x;
-    }
+    return filled;
   }
 
   // Reads only pixels with samples and writes only the pixel itself (which has none), so rows
-  // can be filled in parallel in place. `row`: FindRowSamples of row y. Background at
-  // infinity is the background side once `sky_directions` directions find it (SkyDirections).
+  // can be filled in parallel in place. `row`: the samples beside the pixel in its row.
+  // Background at infinity is the background side once `sky_directions` directions find it
+  // (SkyDirections).
   bool FillPixel(int x, int y, int sky_directions, const RowSamples& row) {
     std::array<Candidate, kMaxDirections> candidates;
     int found = 0, skies = 0;
@@ -242,9 +250,8 @@ class DepthAwareFiller {
   // The nearest sample from (x, y) in direction k: along the row (k = 0 and the opposite one)
   // looked up in `row`, else marched to.
   bool Find(int k, int x, int y, const RowSamples& row, Candidate* out) const {
-    const size_t column = static_cast<size_t>(x);
-    if (k == 0) return InRow(x, y, row.right[column], out);
-    if (2 * k == count_) return InRow(x, y, row.left[column], out);
+    if (k == 0) return InRow(x, y, row.right, out);
+    if (2 * k == count_) return InRow(x, y, row.left, out);
     return March(x, y, &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)], out);
   }
 
@@ -270,7 +277,7 @@ class DepthAwareFiller {
   }
 
   // The sample at `column` of row y as the candidate of a march along the row from x; false
-  // outside the image (FindRowSamples found none).
+  // outside the image (the row has none on that side).
   bool InRow(int x, int y, int column, Candidate* out) const {
     if (column < 0 || column >= width_) return false;
     CandidateAt(Index(column, y), static_cast<float>(std::abs(column - x)), out);
@@ -368,16 +375,7 @@ int FillDepthAware(const ClassMap& classes, const Pinhole& camera, const FillOpt
   DepthAwareFiller filler(options, sky, blend);
   std::vector<int> filled_per_row(static_cast<size_t>(classes.height), 0);
   tbb::parallel_for(0, classes.height, [&](int y) {
-    DepthAwareFiller::RowSamples row;  // Found at the row's first pixel to fill.
-    for (int x = 0; x < classes.width; ++x) {
-      const PixelClass pixel_class = classes.At(x, y);
-      if (!ShouldFill(pixel_class, options)) continue;
-      if (row.left.empty()) filler.FindRowSamples(y, &row);
-      const int sky_directions = filler.SkyDirections(pixel_class, classes.OpenToSky(x, y));
-      if (filler.FillPixel(x, y, sky_directions, row)) {
-        ++filled_per_row[static_cast<size_t>(y)];
-      }
-    }
+    filled_per_row[static_cast<size_t>(y)] = filler.FillRow(classes, options, y);
   });
   int filled = 0;
   for (int n : filled_per_row) filled += n;
