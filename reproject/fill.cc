@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -233,7 +234,8 @@ class DepthAwareFiller {
 
  private:
   struct Step {
-    int dx, dy;  // Pixel offset.
+    int dx, dy;     // Pixel offset.
+    ptrdiff_t di;   // The same as an index offset: dy * width + dx.
   };
 
   size_t Index(int x, int y) const {
@@ -257,16 +259,19 @@ class DepthAwareFiller {
 
   // `steps`: the direction's pixel offsets (MeasureSteps).
   bool March(int x, int y, const Step* steps, Candidate* out) const {
+    const auto start = static_cast<ptrdiff_t>(Index(x, y));
     for (int step = 1; step < max_steps_; ++step) {
-      const int ix = x + steps[step].dx, iy = y + steps[step].dy;
-      if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return false;
-      const size_t j = Index(ix, iy);
-      const SampleKind kind = blend_.kind[j];
-      if (kind == SampleKind::kNone) {
+      // Unsigned, a negative coordinate is past the width too: one test per axis.
+      const auto ix = static_cast<unsigned>(x + steps[step].dx);
+      const auto iy = static_cast<unsigned>(y + steps[step].dy);
+      if (ix >= static_cast<unsigned>(width_) || iy >= static_cast<unsigned>(height_)) return false;
+      const auto j = static_cast<size_t>(start + steps[step].di);
+      if (blend_.kind[j] == SampleKind::kNone) {
         // A step moves at most one pixel along each axis, so the next kBlock * distance - 4
         // steps stay in blocks without samples (distance_); one fewer leaves a step to spare
         // for rounding. Passing them untested, the march finds what it would step by step.
-        const int distance = distance_[BlockIndex(ix / kBlock, iy / kBlock)];
+        const int distance = distance_[BlockIndex(static_cast<int>(ix / kBlock),
+                                                  static_cast<int>(iy / kBlock))];
         if (distance > 1) step += kBlock * distance - 5;
         continue;
       }
@@ -306,8 +311,9 @@ class DepthAwareFiller {
       Step* steps = &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)];
       for (int s = 0; s < max_steps_; ++s) {
         const auto fs = static_cast<float>(s);
-        steps[s] = {static_cast<int>(std::floor(0.5f + fs * dx)),
-                    static_cast<int>(std::floor(0.5f + fs * dy))};
+        const int step_x = static_cast<int>(std::floor(0.5f + fs * dx));
+        const int step_y = static_cast<int>(std::floor(0.5f + fs * dy));
+        steps[s] = {step_x, step_y, static_cast<ptrdiff_t>(step_y) * width_ + step_x};
       }
     }
   }
