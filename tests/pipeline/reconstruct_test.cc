@@ -69,7 +69,10 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   // Measured 0.61 and 0.69 with SfM cameras (their 0.3 degree error costs accuracy).
   EXPECT_GT(depth.within_2pct, 0.5);
   EXPECT_GT(depth.completeness, 0.6);
-  EXPECT_LT(std::abs(depth.signed_median), 0.005);
+  // The bias follows the SfM cameras' scale through the alignment, which changes from run to
+  // run (COLMAP's threads): -0.0012 to -0.0041 in six runs, 0.0055 once in a CI run. 1% still
+  // catches a depth convention or unit error.
+  EXPECT_LT(std::abs(depth.signed_median), 0.01);
 
   // A second identical run skips every stage.
   const ReconstructSummary again = Reconstruct(kSmall / "images", workspace.Path(), {}, progress);
