@@ -6,11 +6,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
-
-#if defined(__AVX2__)
-#include <immintrin.h>
-#endif
 
 #include "core/image.h"
 #include "reproject/forward_warp.h"
@@ -40,38 +35,14 @@ struct Corner {
 using simd::F4;
 using simd::Load4;
 
-// Pixels of a row side by side in a textured block: eight where the build has AVX2 (x86-64-v3,
-// cmake/cpu_level.cmake), else four. Eight: one group instead of two or three across a
-// block about nine pixels wide (K=4 render 640x480 14.9 -> 14.0 ms, 1920x1080 116 -> 111 ms,
-// A/B medians).
-#if defined(__AVX2__)
-constexpr int kLanes = 8;
-#else
-constexpr int kLanes = 4;
-#endif
-using FV = float __attribute__((vector_size(4 * kLanes)));
-using IV = int32_t __attribute__((vector_size(4 * kLanes)));
-
-// Bit k set where lane k of a comparison result is true.
-inline int LaneBits(IV mask) {
-#if defined(__AVX2__)
-  return _mm256_movemask_ps(reinterpret_cast<__m256>(mask));
-#else
-  return simd::LaneBits(mask);
-#endif
-}
-inline FV LoadV(const float* p) {
-  FV value;
-  std::memcpy(&value, p, sizeof(value));
-  return value;
-}
-inline void StoreV(float* p, FV value) { std::memcpy(p, &value, sizeof(value)); }
-// 0, 1, 2, ... per lane.
-inline IV LaneIndices() {
-  IV index;
-  for (int k = 0; k < kLanes; ++k) index[k] = k;
-  return index;
-}
+// Pixels of a row side by side in a textured block: eight with AVX2, one group instead of two
+// or three across a block about nine pixels wide (K=4 render 640x480 14.9 -> 14.0 ms,
+// 1920x1080 116 -> 111 ms, A/B medians).
+using simd::FV;
+using simd::IV;
+using simd::kLanes;
+using simd::LaneBits;
+using simd::LaneIndices;
 
 // A textured block's map from target pixels to its source square: the projective map
 // (homography) that takes the target positions of its corners a, b, c, d to source (0, 0),
@@ -368,7 +339,7 @@ class Rasterizer {
     const bool whole = left >= kLanes;
     FV depth{};
     if (whole) {
-      depth = LoadV(depth_ + i);
+      depth = simd::Load<FV>(depth_ + i);
     } else {
       for (int k = 0; k < left; ++k) depth[k] = depth_[i + static_cast<size_t>(k)];
     }
@@ -388,7 +359,7 @@ class Rasterizer {
     const int bits = LaneBits(write);
     if (bits == 0) return;
     if (whole) {
-      StoreV(depth_ + i, write ? z : depth);
+      simd::Store(depth_ + i, write ? z : depth);
     } else {
       for (int k = 0; k < left; ++k) {
         if (bits >> k & 1) depth_[i + static_cast<size_t>(k)] = z[k];

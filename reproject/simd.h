@@ -6,7 +6,9 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
+#if defined(__AVX2__)
+#include <immintrin.h>
+#elif defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 
@@ -28,13 +30,39 @@ inline int LaneBits(I4 mask) {
 #endif
 }
 
-// Four floats from anywhere (no alignment needed), and back.
-inline F4 Load4(const float* p) {
-  F4 value;
+// Pixels of a row side by side (a textured block's groups): eight where the build has AVX2
+// (x86-64-v3, cmake/cpu_level.cmake), else four.
+#if defined(__AVX2__)
+constexpr int kLanes = 8;
+using FV = float __attribute__((vector_size(32)));
+using IV = int32_t __attribute__((vector_size(32)));
+inline int LaneBits(IV mask) { return _mm256_movemask_ps(reinterpret_cast<__m256>(mask)); }
+#else
+constexpr int kLanes = 4;
+using FV = F4;
+using IV = I4;
+#endif
+
+// 0, 1, 2, ... per lane.
+inline IV LaneIndices() {
+  IV index;
+  for (int k = 0; k < kLanes; ++k) index[k] = k;
+  return index;
+}
+
+// A vector of floats from anywhere (no alignment needed), and back.
+template <typename V>
+V Load(const float* p) {
+  V value;
   std::memcpy(&value, p, sizeof(value));
   return value;
 }
-inline void Store4(float* p, F4 value) { std::memcpy(p, &value, sizeof(value)); }
+template <typename V>
+void Store(float* p, V value) {
+  std::memcpy(p, &value, sizeof(value));
+}
+inline F4 Load4(const float* p) { return Load<F4>(p); }
+inline void Store4(float* p, F4 value) { Store(p, value); }
 
 // Calls f(x) for every x in [0, count) with marks[x] != 0, skipping eight marks at a time
 // where all are 0 (for sparse marks: edges, silhouettes, holes).
