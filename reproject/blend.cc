@@ -42,8 +42,20 @@ struct RowSums {
 // depth only where the front holds a surface.
 void AddSamples(const float* depth, const float* color, const float* weights, size_t width,
                 const RowSums& sums) {
+  // Colour and weight are read here first, two streams per buffer next to the others' and the
+  // sums: the hardware prefetcher fell behind (blend 12.8 -> 10.5 ms at 1920x1080, 1.55 ->
+  // 1.30 ms at 640x480 inside the K=4 render). Asked for kAhead pixels ahead, once per 16
+  // pixels: one cache line of weights and three of colour.
+  constexpr size_t kAhead = 128;
   size_t x = 0;
   for (; x + 4 <= width; x += 4) {
+    if (x % 16 == 0) {
+      const float* next_color = color + 3 * (x + kAhead);
+      __builtin_prefetch(next_color);
+      __builtin_prefetch(next_color + 16);
+      __builtin_prefetch(next_color + 32);
+      __builtin_prefetch(weights + x + kAhead);
+    }
     const F4 d = Load4(depth + x);
     const I4 take = (d > 0) & (d <= Load4(sums.limit + x));
     if (LaneBits(take) == 0) continue;
