@@ -171,10 +171,12 @@ class Rasterizer {
     if (!ClipQuad(a, b, c, d, &box)) return true;
     BlockMap map;
     if (!map.Init<kBackground>(a, b, c, d, side)) return false;
+    PrefetchTexture(a, side);
     const float slack = 1e-5f * side;
     const FV lane = __builtin_convertvector(LaneIndices(), FV) + 0.5f;
     const IV lane_index = LaneIndices();
     for (int y = box.y0; y <= box.y1; ++y) {
+      PrefetchTarget(box.x1, y);
       const float dv = static_cast<float>(y) + 0.5f - a.v;
       const float s_row = map.s_dv * dv, t_row = map.t_dv * dv, w_row = map.w_a + map.w_dv * dv;
       for (int x = box.x0; x <= box.x1; x += kLanes) {
@@ -231,6 +233,33 @@ class Rasterizer {
   struct Box {
     int x0, x1, y0, y1;
   };
+
+  // The block walk moves right along a row of source blocks, so the next blocks read the
+  // texture and write the target a few dozen pixels further right on the same rows: some
+  // twenty streams, more than the hardware prefetcher follows. They are asked for kAhead
+  // pixels ahead: the texture rows once per block, each target row as the block reaches it
+  // (K=4 render 1920x1080: medians 105 -> 98, 108 -> 101 and 110 -> 106 ms in three A/B
+  // runs of four or five rounds; 640x480 13.7 -> 13.0 and 13.7 -> 13.7 ms).
+  static constexpr int kAhead = 32;
+
+  void PrefetchTexture(const Corner& a, float side) const {
+    const int sx = std::min(static_cast<int>(a.sx) + kAhead, texture_width_ - 1);
+    for (int r = 0; r <= static_cast<int>(side) + 1; ++r) {
+      const int sy = std::min(static_cast<int>(a.sy) + r, texture_height_ - 1);
+      const size_t pixel = static_cast<size_t>(sy) * static_cast<size_t>(texture_width_) +
+                           static_cast<size_t>(sx);
+      __builtin_prefetch(texture_ + 3 * pixel);
+    }
+  }
+
+  // Target row y, kAhead pixels right of x.
+  void PrefetchTarget(int x, int y) const {
+    const size_t i = Index(std::min(x + kAhead, width_ - 1), y);
+    __builtin_prefetch(depth_ + i, 1);
+    __builtin_prefetch(weight_ + i, 1);
+    __builtin_prefetch(color_ + 3 * i, 1);
+    __builtin_prefetch(color_ + 3 * i + 16, 1);
+  }
 
   // Twice the signed area of a triangle below which it is degenerate (pixels squared).
   static constexpr float kMinArea2 = 1e-12f;
