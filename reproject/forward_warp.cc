@@ -12,7 +12,6 @@
 #include <sys/mman.h>
 #endif
 
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "reproject/background.h"

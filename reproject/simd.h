@@ -1,7 +1,7 @@
 #pragma once
-// Helpers for the per-pixel loops of reproject/ (internal): four floats side by side, in GCC /
-// Clang vector extensions (SSE on x86-64, NEON on ARM, plain code elsewhere), and sparse marks
-// eight at a time.
+// Helpers for the per-pixel loops of reproject/ (internal): four floats side by side, and the
+// pixels of a row side by side (eight with AVX2, else four), in GCC / Clang vector extensions
+// (SSE or AVX2 on x86-64, NEON on ARM, plain code elsewhere); sparse marks eight at a time.
 #include <cstdint>
 #include <cstring>
 #include <limits>
