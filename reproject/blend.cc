@@ -20,68 +20,59 @@ using simd::LaneBits;
 using simd::Load4;
 using simd::Store4;
 
-// The four lanes of v spread over the twelve channels of four interleaved RGB pixels.
-template <typename V>
-void SpreadOverRgb(V v, V out[3]) {
-  out[0] = __builtin_shufflevector(v, v, 0, 0, 0, 1);
-  out[1] = __builtin_shufflevector(v, v, 1, 1, 2, 2);
-  out[2] = __builtin_shufflevector(v, v, 2, 3, 3, 3);
-}
-
 // The running sums of one row of the blend, and what decides which samples join them.
 struct RowSums {
   const float* front;  // Front-most surface depth; +inf: none.
   const float* limit;  // Samples up to this depth join.
-  float* rgb;          // Interleaved.
+  float* rgbw;         // Weighted colour (RGB) and weight (W) per pixel, interleaved.
   float* depth;
-  float* weight;
 };
+
+// A pixel's colour and weight (RGBW) added to its sums (colour times weight, and weight)
+// where `take` (all lanes alike).
+void AddPixel(F4 rgbw, I4 take, float* sums) {
+  const F4 w = __builtin_shufflevector(rgbw, rgbw, 3, 3, 3, 3);
+  const F4 added = I4{0, 0, 0, -1} ? w : rgbw * w;
+  Store4(sums, Load4(sums) + (take ? added : F4{}));
+}
 
 // Adds the samples of one buffer's row that lie within the limit (0 < depth <= limit) to the
 // sums, four pixels at a time (the row's last width % 4 pixels one at a time); a surface's
-// depth only where the front holds a surface.
-void AddSamples(const float* depth, const float* color, const float* weights, size_t width,
+// depth only where the front holds a surface. `color_weight`: WarpBuffer::ColorWeights.
+void AddSamples(const float* depth, const uint16_t* color_weight, size_t width,
                 const RowSums& sums) {
-  // Colour and weight are read here first, two streams per buffer next to the others' and the
+  // Colour and weight are read here first, a stream per buffer next to the others' and the
   // sums: the hardware prefetcher fell behind (blend 12.8 -> 10.5 ms at 1920x1080, 1.55 ->
-  // 1.30 ms at 640x480 inside the K=4 render). Asked for kAhead pixels ahead, once per 16
-  // pixels: one cache line of weights and three of colour.
+  // 1.30 ms at 640x480 inside the K=4 render, with floats). Asked for kAhead pixels ahead,
+  // a cache line (8 pixels) at a time.
   constexpr size_t kAhead = 128;
   size_t x = 0;
   for (; x + 4 <= width; x += 4) {
-    if (x % 16 == 0) {
-      const float* next_color = color + 3 * (x + kAhead);
-      __builtin_prefetch(next_color);
-      __builtin_prefetch(next_color + 16);
-      __builtin_prefetch(next_color + 32);
-      __builtin_prefetch(weights + x + kAhead);
-    }
+    if (x % 8 == 0) __builtin_prefetch(color_weight + 4 * (x + kAhead));
     const F4 d = Load4(depth + x);
     const I4 take = (d > 0) & (d <= Load4(sums.limit + x));
     if (LaneBits(take) == 0) continue;
     // Colour and weight are written only where a sample landed: lanes not taken may hold
     // anything, and are selected away, never added.
-    const F4 w = take ? Load4(weights + x) : F4{};
+    const uint16_t* samples = color_weight + 4 * x;
+    const F4 rgbw[4] = {simd::LoadHalf4(samples), simd::LoadHalf4(samples + 4),
+                        simd::LoadHalf4(samples + 8), simd::LoadHalf4(samples + 12)};
+    float* sum = sums.rgbw + 4 * x;
+    AddPixel(rgbw[0], __builtin_shufflevector(take, take, 0, 0, 0, 0), sum);
+    AddPixel(rgbw[1], __builtin_shufflevector(take, take, 1, 1, 1, 1), sum + 4);
+    AddPixel(rgbw[2], __builtin_shufflevector(take, take, 2, 2, 2, 2), sum + 8);
+    AddPixel(rgbw[3], __builtin_shufflevector(take, take, 3, 3, 3, 3), sum + 12);
+    const F4 w = {rgbw[0][3], rgbw[1][3], rgbw[2][3], rgbw[3][3]};
     const I4 surface = Load4(sums.front + x) != WarpBuffer::kBackground;
     Store4(sums.depth + x, Load4(sums.depth + x) + ((take & surface) ? w * d : F4{}));
-    Store4(sums.weight + x, Load4(sums.weight + x) + w);
-    F4 w_rgb[3];
-    I4 take_rgb[3];
-    SpreadOverRgb(w, w_rgb);
-    SpreadOverRgb(take, take_rgb);
-    for (size_t k = 0; k < 3; ++k) {
-      float* sum = sums.rgb + 3 * x + 4 * k;
-      const F4 added = w_rgb[k] * Load4(color + 3 * x + 4 * k);
-      Store4(sum, Load4(sum) + (take_rgb[k] ? added : F4{}));
-    }
   }
   for (; x < width; ++x) {
     const float d = depth[x];
     if (!(d > 0 && d <= sums.limit[x])) continue;
-    const float w = weights[x];
-    for (size_t k = 0; k < 3; ++k) sums.rgb[3 * x + k] += w * color[3 * x + k];
+    const F4 rgbw = simd::LoadHalf4(color_weight + 4 * x);
+    const float w = rgbw[3];
+    AddPixel(rgbw, I4{} - 1, sums.rgbw + 4 * x);
     if (sums.front[x] != WarpBuffer::kBackground) sums.depth[x] += w * d;
-    sums.weight[x] += w;
   }
 }
 
@@ -93,12 +84,11 @@ void BlendRow(std::span<const WarpBuffer> buffers, int y, float tolerance, int m
   const size_t row = static_cast<size_t>(y) * width;
   scratch->resize(8 * width);
   float* front = scratch->data();             // Front-most surface depth; +inf: none.
-  float* rgb_sum = front + width;             // Interleaved.
-  float* depth_sum = rgb_sum + 3 * width;
-  float* weight = depth_sum + width;
-  float* any_background = weight + width;     // 1 where a background sample landed.
+  float* rgbw_sum = front + width;            // Interleaved: weighted RGB, weight.
+  float* depth_sum = rgbw_sum + 4 * width;
+  float* any_background = depth_sum + width;  // 1 where a background sample landed.
   std::fill(front, front + width, WarpBuffer::kBackground);
-  std::fill(rgb_sum, any_background + width, 0.0f);
+  std::fill(rgbw_sum, any_background + width, 0.0f);
   float* back = depth_sum;  // Farthest surface depth; 0: none (depth_sum is zeroed below).
   // Without branches (depth 0 maps to +inf for the front, background to 0 for the back), so
   // that it vectorises.
@@ -143,50 +133,25 @@ void BlendRow(std::span<const WarpBuffer> buffers, int y, float tolerance, int m
   // background samples (nothing else landed there).
   float* limit = any_background + width;
   for (size_t x = 0; x < width; ++x) limit[x] = front[x] * (1.0f + tolerance);
-  const RowSums sums{front, limit, rgb_sum, depth_sum, weight};
+  const RowSums sums{front, limit, rgbw_sum, depth_sum};
   for (const WarpBuffer& buffer : buffers) {
-    AddSamples(buffer.Depths() + row, buffer.Color(row), buffer.Weights() + row, width, sums);
+    AddSamples(buffer.Depths() + row, buffer.ColorWeights() + 4 * row, width, sums);
   }
   float* rgb_out = out->color.Pixels().data() + 3 * row;
   float* depth_out = out->depth.Values().data() + row;
   SampleKind* kind_out = out->kind.data() + row;
   // Every pixel: where something landed the weighted means, elsewhere 0 and kNone. Weights
-  // are positive and finite (angles >= 0, epsilon > 0); guarded anyway so a degenerate
-  // sample can never write NaN.
-  size_t x = 0;
-  for (; x + 4 <= width; x += 4) {
-    const I4 surface = Load4(front + x) != WarpBuffer::kBackground;
-    const F4 w = Load4(weight + x);
-    const I4 blended = (surface | (Load4(any_background + x) != 0.0f)) & (w > 0) & (w <= kFloatMax);
-    const int bits = LaneBits(blended);
-    const F4 inv = 1.0f / w;
-    F4 inv_rgb[3];
-    I4 blended_rgb[3];
-    SpreadOverRgb(inv, inv_rgb);
-    SpreadOverRgb(blended, blended_rgb);
-    for (size_t k = 0; k < 3; ++k) {
-      float* rgb = rgb_out + 3 * x + 4 * k;
-      Store4(rgb, blended_rgb[k] ? Load4(rgb_sum + 3 * x + 4 * k) * inv_rgb[k] : F4{});
-    }
-    Store4(depth_out + x, (blended & surface) ? Load4(depth_sum + x) * inv : F4{});
-    for (size_t k = 0; k < 4; ++k) {
-      kind_out[x + k] = (bits >> k & 1) == 0 ? SampleKind::kNone
-                        : surface[k] != 0    ? SampleKind::kSurface
-                                             : SampleKind::kBackground;
-    }
-  }
-  for (; x < width; ++x) {
+  // are positive and finite (clamped by the warp); guarded anyway so a degenerate sample can
+  // never write NaN.
+  for (size_t x = 0; x < width; ++x) {
+    const F4 sum = Load4(rgbw_sum + 4 * x);
+    const float weight = sum[3];
     const bool surface = front[x] != WarpBuffer::kBackground;
-    if ((!surface && any_background[x] == 0.0f) || !(weight[x] > 0) || !(weight[x] <= kFloatMax)) {
-      for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = 0.0f;
-      depth_out[x] = 0.0f;
-      kind_out[x] = SampleKind::kNone;
-      continue;
-    }
-    const float inv = 1.0f / weight[x];
-    for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = rgb_sum[3 * x + k] * inv;
+    const bool blended = (surface || any_background[x] != 0.0f) && weight > 0 && weight <= kFloatMax;
+    const float inv = blended ? 1.0f / weight : 0.0f;
+    for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = sum[k] * inv;
     depth_out[x] = surface ? depth_sum[x] * inv : 0.0f;
-    kind_out[x] = surface ? SampleKind::kSurface : SampleKind::kBackground;
+    kind_out[x] = !blended ? SampleKind::kNone : surface ? SampleKind::kSurface : SampleKind::kBackground;
   }
 }
 

@@ -681,12 +681,18 @@ void WarpBuffer::Reset(int width, int height) {
   const size_t count = Size();
   if (count > capacity_) {
     Allocate(&depth_, count);
-    Allocate(&color_, 3 * count);
-    Allocate(&weight_, count);
+    Allocate(&color_weight_, 4 * count);
     capacity_ = count;
   }
   std::fill(depth_.get(), depth_.get() + count, 0.0f);
 }
+
+std::array<float, 3> WarpBuffer::Color(size_t i) const {
+  const simd::F4 rgbw = simd::LoadHalf4(color_weight_.get() + 4 * i);
+  return {rgbw[0], rgbw[1], rgbw[2]};
+}
+
+float WarpBuffer::Weight(size_t i) const { return simd::LoadHalf4(color_weight_.get() + 4 * i)[3]; }
 
 WarpScratch::WarpScratch() : data_(std::make_unique<Data>()) {}
 WarpScratch::~WarpScratch() = default;

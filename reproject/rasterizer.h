@@ -135,8 +135,7 @@ class Rasterizer {
         width_(buffer->Width()),
         height_(buffer->Height()),
         depth_(buffer->MutableDepth()),
-        color_(buffer->MutableColor()),
-        weight_(buffer->MutableWeight()),
+        color_weight_(buffer->MutableColorWeights()),
         texture_(texture.Pixels().data()),
         texture_width_(texture.Width()),
         texture_height_(texture.Height()),
@@ -256,9 +255,7 @@ class Rasterizer {
   void PrefetchTarget(int x, int y) const {
     const size_t i = Index(std::min(x + kAhead, width_ - 1), y);
     __builtin_prefetch(depth_ + i, 1);
-    __builtin_prefetch(weight_ + i, 1);
-    __builtin_prefetch(color_ + 3 * i, 1);
-    __builtin_prefetch(color_ + 3 * i + 16, 1);
+    __builtin_prefetch(color_weight_ + 4 * i, 1);
   }
 
   // Twice the signed area of a triangle below which it is degenerate (pixels squared).
@@ -344,8 +341,19 @@ class Rasterizer {
   void Write(size_t i, float depth, const float q[3], const Corner& a, const Corner& b,
              const Corner& c, float stretch) {
     depth_[i] = depth;
-    for (int k = 0; k < 3; ++k) color_[3 * i + k] = q[0] * a.rgb[k] + q[1] * b.rgb[k] + q[2] * c.rgb[k];
-    weight_[i] = Weight(q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch);
+    F4 rgbw;
+    for (int k = 0; k < 3; ++k) rgbw[k] = q[0] * a.rgb[k] + q[1] * b.rgb[k] + q[2] * c.rgb[k];
+    rgbw[3] = Weight(q[0] * a.angle + q[1] * b.angle + q[2] * c.angle, stretch);
+    StoreColorWeight(i, rgbw);
+  }
+
+  // Colour (RGB) and weight of target pixel i, in WarpBuffer::ColorWeights' halves.
+  void StoreColorWeight(size_t i, F4 rgbw) {
+    constexpr float kMax = WarpBuffer::kMaxHalf;
+    const F4 low = {-kMax, -kMax, -kMax, WarpBuffer::kMinWeight};
+    rgbw = rgbw > low ? rgbw : low;
+    rgbw = rgbw < kMax ? rgbw : F4{} + kMax;
+    simd::StoreHalf4(color_weight_ + 4 * i, rgbw);
   }
 
   // WarpBuffer::Weight of samples at ray angle `angle` (a float, or lanes) and area
@@ -400,13 +408,9 @@ class Rasterizer {
     const Taps taps = TapsAt(sx, sy, map.stretch);
     for (int k = 0; k < kLanes; ++k) {
       if ((bits >> k & 1) == 0) continue;
-      const size_t pixel = i + static_cast<size_t>(k);
-      weight_[pixel] = weight[k];
-      if (taps.bicubic[k] != 0) {
-        Bicubic(pixel, sx[k], sy[k]);
-      } else {
-        Bilinear(pixel, taps, k);
-      }
+      F4 rgbw = taps.bicubic[k] != 0 ? Bicubic(sx[k], sy[k]) : Bilinear(taps, k);
+      rgbw[3] = weight[k];
+      StoreColorWeight(i + static_cast<size_t>(k), rgbw);
     }
   }
 
@@ -445,30 +449,30 @@ class Rasterizer {
     return t;
   }
 
-  // Lane k of `taps` into target pixel i.
-  void Bilinear(size_t i, const Taps& taps, int k) {
+  // The colour at lane k of `taps` (lane 3 undefined).
+  F4 Bilinear(const Taps& taps, int k) const {
     const size_t row = static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_);
     const float* t00 = texture_ + 3 * (row + static_cast<size_t>(taps.x0[k]));
     const float* t10 = t00 + taps.step_x[k];
     const float* t01 = t00 + taps.step_y[k];
     const float* t11 = t01 + taps.step_x[k];
     const float w00 = taps.w00[k], w10 = taps.w10[k], w01 = taps.w01[k], w11 = taps.w11[k];
-    float* out = color_ + 3 * i;
-    // Four lanes per tap (RGB and the next pixel's R, dropped), except at the last pixel,
-    // which has no next one.
+    // Four lanes per tap (RGB and the next pixel's R), except at the last pixel, which has
+    // no next one.
     if (t11 + 3 < texture_end_) {
-      const F4 rgb = w00 * Load4(t00) + w10 * Load4(t10) + w01 * Load4(t01) + w11 * Load4(t11);
-      for (int c = 0; c < 3; ++c) out[c] = rgb[c];
-      return;
+      return w00 * Load4(t00) + w10 * Load4(t10) + w01 * Load4(t01) + w11 * Load4(t11);
     }
-    for (int c = 0; c < 3; ++c) out[c] = w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+    F4 rgb{};
+    for (int c = 0; c < 3; ++c) rgb[c] = w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
+    return rgb;
   }
 
   // Where the target samples the source more densely than its pixels (magnified), and
   // between pixels generally, bilinear interpolation blurs the texture: Catmull-Rom over
   // 4 x 4 source pixels keeps it sharper. Inside the image by at least one pixel, and a row
   // above the last, so that the last tap's 4-lane load stays inside (the caller checks).
-  void Bicubic(size_t i, float sx, float sy) {
+  // Lane 3 undefined.
+  F4 Bicubic(float sx, float sy) const {
     const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
     float wx[4], wy[4];
     CatmullRom(sx - static_cast<float>(x0), wx);
@@ -482,7 +486,7 @@ class Rasterizer {
       rgb += wy[r] * across;
     }
     // The kernel's negative lobes can undershoot below black.
-    for (int k = 0; k < 3; ++k) color_[3 * i + k] = std::max(rgb[k], 0.0f);
+    return rgb > 0.0f ? rgb : F4{};
   }
 
   static void CatmullRom(float t, float w[4]) {
@@ -503,8 +507,7 @@ class Rasterizer {
   int width_;
   int height_;
   float* depth_;
-  float* color_;
-  float* weight_;
+  uint16_t* color_weight_;
   const float* texture_;
   int texture_width_;
   int texture_height_;

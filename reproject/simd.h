@@ -1,12 +1,13 @@
 #pragma once
 // Helpers for the per-pixel loops of reproject/ (internal): four floats side by side, and the
 // pixels of a row side by side (eight with AVX2, else four), in GCC / Clang vector extensions
-// (SSE or AVX2 on x86-64, NEON on ARM, plain code elsewhere); sparse marks eight at a time.
+// (SSE or AVX2 on x86-64, NEON on ARM, plain code elsewhere); four floats as half floats;
+// sparse marks eight at a time.
 #include <cstdint>
 #include <cstring>
 #include <limits>
 
-#if defined(__AVX2__)
+#if defined(__AVX2__) || defined(__F16C__)
 #include <immintrin.h>
 #elif defined(__SSE2__)
 #include <emmintrin.h>
@@ -63,6 +64,79 @@ void Store(float* p, V value) {
 }
 inline F4 Load4(const float* p) { return Load<F4>(p); }
 inline void Store4(float* p, F4 value) { Store(p, value); }
+
+// Four floats as IEEE half floats (binary16, rounded to nearest even; 8 bytes), and back: the
+// warp buffers' colour and weight. Portable integer arithmetic here; with F16C (x86-64-v3)
+// StoreHalf4 and LoadHalf4 below use its instructions, with the same results (NaN payloads
+// aside).
+using U4 = uint32_t __attribute__((vector_size(16)));
+using H4 = uint16_t __attribute__((vector_size(8)));  // Four halves' bits.
+
+inline U4 Bits(F4 value) {
+  U4 bits;
+  std::memcpy(&bits, &value, sizeof(bits));
+  return bits;
+}
+inline F4 FromBits(U4 bits) {
+  F4 value;
+  std::memcpy(&value, &bits, sizeof(value));
+  return value;
+}
+
+// Halves in the low 16 bits of each lane.
+inline U4 HalfBitsPortable(F4 value) {
+  const U4 bits = Bits(value);
+  const U4 sign = (bits >> 16) & 0x8000u;
+  const U4 magnitude = bits & 0x7fffffffu;
+  // 65520 (2^15 (2 - 2^-11)) and above round to infinity; NaN stays a (quiet) NaN.
+  const U4 overflow = magnitude > 0x7f800000u ? 0x7e00u : 0x7c00u;
+  // Below 2^-14, a half is a multiple of 2^-24: adding 0.5 (2^-1) makes the float's own
+  // rounding (to nearest even) round the value to that multiple, left in the low mantissa bits.
+  const F4 subnormal_sum = FromBits(magnitude) + 0.5f;
+  const U4 subnormal = Bits(subnormal_sum) - 0x3f000000u;
+  // Normal: rebias the exponent (127 -> 15) and drop 13 mantissa bits, rounding to nearest
+  // even: add half a unit less one, plus the lowest kept bit (a carry into the exponent is
+  // right, up to infinity).
+  const U4 odd = (magnitude >> 13) & 1u;
+  const U4 normal = (magnitude - ((127u - 15u) << 23) + 0xfffu + odd) >> 13;
+  const U4 half = magnitude >= 0x47800000u  ? overflow
+                  : magnitude < 0x38800000u ? subnormal
+                                            : normal;
+  return half | sign;
+}
+
+inline F4 FromHalfBitsPortable(U4 half) {
+  const U4 sign = (half & 0x8000u) << 16;
+  const U4 exponent = half & 0x7c00u;
+  const U4 shifted = (half & 0x7fffu) << 13;
+  // Rebias the exponent (15 -> 127); infinity and NaN keep the largest one, and zero and
+  // subnormals (exponent 0) are their mantissa times 2^-24, as the float 2^-14 (1 + m) - 2^-14.
+  const U4 normal = shifted + ((127u - 15u) << 23);
+  const U4 special = normal + ((128u - 16u) << 23);
+  const F4 subnormal = FromBits(shifted + (113u << 23)) - FromBits(U4{} + (113u << 23));
+  const U4 magnitude = exponent == 0x7c00u ? special : exponent == 0 ? Bits(subnormal) : normal;
+  return FromBits(magnitude | sign);
+}
+
+inline void StoreHalf4(uint16_t* p, F4 value) {
+#if defined(__F16C__)
+  const __m128i half = _mm_cvtps_ph(reinterpret_cast<__m128>(value), _MM_FROUND_TO_NEAREST_INT);
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(p), half);
+#else
+  const H4 half = __builtin_convertvector(HalfBitsPortable(value), H4);
+  std::memcpy(p, &half, sizeof(half));
+#endif
+}
+
+inline F4 LoadHalf4(const uint16_t* p) {
+#if defined(__F16C__)
+  return reinterpret_cast<F4>(_mm_cvtph_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
+#else
+  H4 half;
+  std::memcpy(&half, p, sizeof(half));
+  return FromHalfBitsPortable(__builtin_convertvector(half, U4));
+#endif
+}
 
 // Calls f(x) for every x in [0, count) with marks[x] != 0, skipping eight marks at a time
 // where all are 0 (for sparse marks: edges, silhouettes, holes).

@@ -44,7 +44,7 @@ TEST(ForwardWarp, IdentityPoseReproducesSourceForBothMethods) {
     options.method = method;
     WarpBuffer buffer;
     ForwardWarp(source, camera, options, &buffer);
-    double max_color_error = 0, max_depth_error = 0;
+    double max_color_error_scaled = 0, max_depth_error = 0;
     for (int y = 0; y < 120; ++y) {
       for (int x = 0; x < 160; ++x) {
         const size_t i = static_cast<size_t>(y * 160 + x);
@@ -53,12 +53,14 @@ TEST(ForwardWarp, IdentityPoseReproducesSourceForBothMethods) {
                                    std::abs(static_cast<double>(buffer.Depth(i) - source.depth.At(x, y))) /
                                        static_cast<double>(source.depth.At(x, y)));
         for (int c = 0; c < 3; ++c) {
-          max_color_error = std::max(max_color_error, static_cast<double>(std::abs(buffer.Color(i)[c] - source.color.At(x, y, c))));
+          // Relative to the value's half rounding (WarpBuffer::ColorWeights).
+          const double error = std::abs(buffer.Color(i)[c] - source.color.At(x, y, c));
+          max_color_error_scaled = std::max(max_color_error_scaled, error / (1e-4 + WarpBuffer::kHalfRounding * static_cast<double>(source.color.At(x, y, c))));
         }
       }
     }
     EXPECT_LT(max_depth_error, 1e-5);
-    EXPECT_LT(max_color_error, 1e-4);
+    EXPECT_LT(max_color_error_scaled, 1);
   }
 }
 
@@ -332,7 +334,7 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
   const RenderResult result = Render({&source}, target, options);
 
   int checked = 0, wrong_class = 0;
-  double max_error_px = 0;
+  double max_error_scaled = 0;
   for (int y = 0; y < 120; ++y) {
     for (int x = 0; x < 160; ++x) {
       const Eigen::Vector3d dir = test::PixelRay(target, x, y);
@@ -352,15 +354,17 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
         continue;
       }
       // Decode the direction the colour came from and compare in source pixels.
+      // Over the error of the colour's half rounding in pixels, plus 0.02.
       const double red = result.color.At(x, y, 0), green = result.color.At(x, y, 1);
       const double du = 150 * (red - 0.5) / 0.4 - 150 * dir.x() / dir.z();
       const double dv = 150 * (green - 0.5) / 0.4 - 150 * dir.y() / dir.z();
-      max_error_px = std::max(max_error_px, std::hypot(du, dv));
+      const double rounding_px = 150 / 0.4 * WarpBuffer::kHalfRounding * std::hypot(red, green);
+      max_error_scaled = std::max(max_error_scaled, std::hypot(du, dv) / (0.02 + rounding_px));
     }
   }
   EXPECT_GT(checked, 160 * 120 / 2);
   EXPECT_EQ(wrong_class, 0);
-  EXPECT_LT(max_error_px, 0.02);
+  EXPECT_LT(max_error_scaled, 1);
   EXPECT_EQ(result.metrics.disocclusion_ratio, 0);
   // Background never reaches the depth map.
   for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z));
@@ -424,8 +428,8 @@ TEST(ForwardWarp, BandsDrawWhatOneBandDraws) {
           continue;
         }
         if (one.Depth(i) == 0) continue;  // Colour and weight mean nothing there.
-        differ += std::memcmp(banded.Color(i), one.Color(i), 3 * sizeof(float)) != 0 ||
-                  banded.Weight(i) != one.Weight(i);
+        differ += std::memcmp(banded.ColorWeights() + 4 * i, one.ColorWeights() + 4 * i,
+                              4 * sizeof(uint16_t)) != 0;
       }
       EXPECT_EQ(differ, 0u) << "bands " << bands << ", method " << static_cast<int>(method);
     }
@@ -509,7 +513,7 @@ TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
   const PosedCamera target = CameraAt(camera, centre);
   WarpBuffer buffer;
   ForwardWarp(source, target, {}, &buffer);
-  double position_error = 0, depth_error = 0;
+  double position_error_scaled = 0, depth_error = 0;
   int checked = 0;
   for (int ty = 0; ty < 120; ++ty) {
     for (int tx = 0; tx < 160; ++tx) {
@@ -522,16 +526,18 @@ TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
       const double sx = f * point.x() / point.z() + cx - 0.5;
       const double sy = f * point.y() / point.z() + cy - 0.5;
       if (sx < 1.5 || sy < 1.5 || sx > 157.5 || sy > 117.5) continue;
+      // Over 0.01 pixels plus the colour's half rounding in pixels.
       const double red = buffer.Color(i)[0], green = buffer.Color(i)[1];
-      position_error =
-          std::max({position_error, std::abs(red * 256 - sx), std::abs(green * 256 - sy)});
+      const auto bound = [](double value) { return 0.01 + 256 * WarpBuffer::kHalfRounding * value; };
+      position_error_scaled = std::max({position_error_scaled, std::abs(red * 256 - sx) / bound(red),
+                                 std::abs(green * 256 - sy) / bound(green)});
       const double z = buffer.Depth(i);
       depth_error = std::max(depth_error, std::abs(z / (point.z() - centre.z()) - 1));
       ++checked;
     }
   }
   EXPECT_GT(checked, 12000);
-  EXPECT_LT(position_error, 0.01);
+  EXPECT_LT(position_error_scaled, 1);
   EXPECT_LT(depth_error, 1e-4);
 }
 

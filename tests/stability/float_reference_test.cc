@@ -258,8 +258,9 @@ void CompareProjections(const SourceView& source, const PosedCamera& target,
       const double epsilon = options.angle_epsilon_rad;
       const double weight = 1 / ((chord + epsilon) * std::max(1.0, stretch));
       // The chord's error is absolute (a difference of unit vectors, ~8 kEps), the stretch's
-      // twice z's relative error (8 kEps kappa), plus a few roundings.
-      const double bound = 8 * kEps / (chord + epsilon) + (16 * kappa + 4) * kEps;
+      // twice z's relative error (8 kEps kappa), plus a few roundings and the half float it
+      // is stored in.
+      const double bound = 8 * kEps / (chord + epsilon) + (16 * kappa + 4) * kEps + WarpBuffer::kHalfRounding;
       errors->weight_scaled = std::max(
           errors->weight_scaled, std::abs(static_cast<double>(buffer.Weight(i)) / weight - 1) / bound);
       const double u = t.FocalX() * point.x() / point.z() + t.PrincipalX();
