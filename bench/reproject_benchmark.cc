@@ -78,7 +78,7 @@ SourceView Upsampled(const SourceView& view, int scale, int height) {
               : view.depth.At(x / scale, (y + crop) / scale);
     }
   }
-  MarkSourceBackground(&out);  // The copied mask was the small view's.
+  PrepareSource(&out);  // The copied mask and texture were the small view's.
   return out;
 }
 

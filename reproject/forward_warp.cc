@@ -64,6 +64,7 @@ struct WarpScratch::Data {
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
   std::vector<float> ray_x;         // Per source column: (x + 0.5 - cx) / fx.
+  std::vector<uint16_t> texture;    // SourceView::texture, when the source has none.
 };
 
 namespace {
@@ -257,6 +258,21 @@ void PenaliseSilhouetteRow(const WarpSetup& s, float penalty, int y, uint8_t* ma
   mark(last, above[last - 1] & below[last - 1]);
   float* angle = vtx->angle.get() + vtx->At(row);
   simd::ForEachMarked(marks, width, [&](int x) { angle[x] += penalty; });
+}
+
+// SourceView::texture of `color` (3 channels), values beyond a half's range clamped to it.
+void MakeTexture(const Image& color, std::vector<uint16_t>* texture) {
+  const size_t count = static_cast<size_t>(color.Width()) * static_cast<size_t>(color.Height());
+  texture->resize(4 * count);
+  const float* rgb = color.Pixels().data();
+  uint16_t* out = texture->data();
+  constexpr float kMax = WarpBuffer::kMaxHalf;
+  for (size_t i = 0; i < count; ++i) {
+    simd::F4 value = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2], 0.0f};
+    value = value > -kMax ? value : simd::F4{} - kMax;
+    value = value < kMax ? value : simd::F4{} + kMax;
+    simd::StoreHalf4(out + 4 * i, value);
+  }
 }
 
 template <typename T>
@@ -703,11 +719,15 @@ const std::vector<uint8_t>& WarpScratch::Background() const {
   return data_->background_used != nullptr ? *data_->background_used : kNone;
 }
 
-void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options) {
+void PrepareSource(SourceView* source, const ForwardWarpOptions& options) {
   options.Check();
-  const auto step = static_cast<float>(options.background_max_step);
-  source->background = MarkBackground(source->depth, source->color, step);
-  source->background_step = step;
+  CheckSourceView(*source);
+  MakeTexture(source->color, &source->texture);
+  if (options.background_at_infinity) {
+    const auto step = static_cast<float>(options.background_max_step);
+    source->background = MarkBackground(source->depth, source->color, step);
+    source->background_step = step;
+  }
 }
 
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
@@ -732,6 +752,11 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
       data.background_used = &data.background;
     }
   }
+  const std::vector<uint16_t>* texture = &source.texture;
+  if (texture->size() != 4 * count) {
+    MakeTexture(source.color, &data.texture);
+    texture = &data.texture;
+  }
   data.ray_x.resize(static_cast<size_t>(width));
   for (int x = 0; x < width; ++x) {
     data.ray_x[static_cast<size_t>(x)] = static_cast<float>((x + 0.5 - setup.src.cx) / setup.src.fx);
@@ -749,8 +774,8 @@ void ForwardWarp(const SourceView& source, const PosedCamera& target,
     BandScratch& own = data.bands[static_cast<size_t>(band)];
     RowWindow rows(setup, source, background, data.ray_x.data(), options, &own);
     const int target_rows = setup.dst.height;
-    Rasterizer raster(buffer, source.color, options, band * target_rows / band_count,
-                      (band + 1) * target_rows / band_count);
+    Rasterizer raster(buffer, texture->data(), width, height, options,
+                      band * target_rows / band_count, (band + 1) * target_rows / band_count);
     SourceWarper warper(source, setup, &rows, options, &raster);
     if (options.method == WarpMethod::kMesh) {
       warper.Mesh();

@@ -151,9 +151,11 @@ class WarpScratch {
   std::unique_ptr<Data> data_;
 };
 
-// Marks source->background (MarkBackground of its depth and colour, with the options'
-// background_max_step) for the warps to share; call again whenever the depth changes.
-void MarkSourceBackground(SourceView* source, const ForwardWarpOptions& options = {});
+// Makes what every warp of the source would otherwise make again, for the warps to share:
+// source->texture, and source->background (MarkBackground of its depth and colour, with the
+// options' background_max_step) where the options warp background at infinity. Call again
+// whenever the depth or colour changes.
+void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {});
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see

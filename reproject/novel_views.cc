@@ -182,7 +182,7 @@ const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp)
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     CheckSourceView(*view);
-    if (warp.background_at_infinity) MarkSourceBackground(view.get(), warp);
+    PrepareSource(view.get(), warp);
     slot = std::move(view);
   }
   return *slot;

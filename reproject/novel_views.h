@@ -42,8 +42,8 @@ class SourceLibrary {
   explicit SourceLibrary(ViewSetPaths paths);
   const std::vector<PosedCamera>& Cameras() const { return cameras_; }
   const std::vector<std::string>& Names() const { return names_; }
-  // On first use marks the view's background for warps with `warp` (MarkSourceBackground),
-  // only when they warp background at infinity (--warp naive does not). Throws BadInputError
+  // On first use prepares the view for warps with `warp` (PrepareSource: its texture, and its
+  // background where they warp background at infinity; --warp naive does not). Throws BadInputError
   // naming the file for a missing or corrupt photo or depth map.
   const SourceView& Load(int index, const ForwardWarpOptions& warp);
   int LoadedCount() const;

@@ -33,7 +33,7 @@ struct Corner {
 
 // Colour channels (RGB and one more) side by side.
 using simd::F4;
-using simd::Load4;
+using simd::LoadHalf4;
 
 // Pixels of a row side by side in a textured block: eight with AVX2, one group instead of two
 // or three across a block about nine pixels wide (K=4 render 640x480 14.9 -> 14.0 ms,
@@ -125,8 +125,10 @@ class Rasterizer {
  public:
   // Draws only target rows [row_begin, row_end): rasterisers of disjoint row bands may share
   // one buffer from different threads.
-  Rasterizer(WarpBuffer* buffer, const Image& texture, const ForwardWarpOptions& options,
-             int row_begin, int row_end)
+  // `texture`: the source's colour as SourceView::texture holds it (half floats, RGBA),
+  // texture_width x texture_height pixels.
+  Rasterizer(WarpBuffer* buffer, const uint16_t* texture, int texture_width, int texture_height,
+             const ForwardWarpOptions& options, int row_begin, int row_end)
       : row_begin_(row_begin),
         row_end_(row_end),
         bicubic_min_stretch_(options.texture_filter == TextureFilter::kBicubic ? 0.0f
@@ -136,10 +138,9 @@ class Rasterizer {
         height_(buffer->Height()),
         depth_(buffer->MutableDepth()),
         color_weight_(buffer->MutableColorWeights()),
-        texture_(texture.Pixels().data()),
-        texture_width_(texture.Width()),
-        texture_height_(texture.Height()),
-        texture_end_(texture.Pixels().data() + texture.Pixels().size()) {}
+        texture_(texture),
+        texture_width_(texture_width),
+        texture_height_(texture_height) {}
 
   // Perspective-correct: inverse depth is affine in the image, attributes / z too.
   void SurfaceTriangle(const Corner& a, const Corner& b, const Corner& c) {
@@ -247,7 +248,7 @@ class Rasterizer {
       const int sy = std::min(static_cast<int>(a.sy) + r, texture_height_ - 1);
       const size_t pixel = static_cast<size_t>(sy) * static_cast<size_t>(texture_width_) +
                            static_cast<size_t>(sx);
-      __builtin_prefetch(texture_ + 3 * pixel);
+      __builtin_prefetch(texture_ + 4 * pixel);
     }
   }
 
@@ -419,7 +420,7 @@ class Rasterizer {
   // the pixel (x0, y0) at or before the position, its right and lower neighbours (the pixel
   // itself on the last column / row) and weights.
   struct Taps {
-    IV bicubic, x0, y0, step_x, step_y;  // Steps in floats.
+    IV bicubic, x0, y0, step_x, step_y;  // Steps in halves.
     FV w00, w10, w01, w11;
   };
 
@@ -429,7 +430,7 @@ class Rasterizer {
     Taps t;
     const IV magnified = IV{} - (stretch > bicubic_min_stretch_ ? 1 : 0);
     t.bicubic = magnified & (sx >= 1.0f) & (sy >= 1.0f) & (sx < last_x - 1.0f) &
-                (sy < last_y - 2.0f);
+                (sy < last_y - 1.0f);
     // Clamped to the image (the interpolation can overshoot a corner by a hair; NaN to 0);
     // then non-negative, so truncation is floor.
     sx = sx > 0.0f ? sx : FV{};
@@ -440,8 +441,8 @@ class Rasterizer {
     t.y0 = __builtin_convertvector(sy, IV);
     const FV fx = sx - __builtin_convertvector(t.x0, FV);
     const FV fy = sy - __builtin_convertvector(t.y0, FV);
-    t.step_x = (t.x0 < texture_width_ - 1) & 3;
-    t.step_y = (t.y0 < texture_height_ - 1) & (3 * texture_width_);
+    t.step_x = (t.x0 < texture_width_ - 1) & 4;
+    t.step_y = (t.y0 < texture_height_ - 1) & (4 * texture_width_);
     t.w00 = (1 - fx) * (1 - fy);
     t.w10 = fx * (1 - fy);
     t.w01 = (1 - fx) * fy;
@@ -449,29 +450,21 @@ class Rasterizer {
     return t;
   }
 
-  // The colour at lane k of `taps` (lane 3 undefined).
+  // The colour at lane k of `taps` (lane 3 is 0).
   F4 Bilinear(const Taps& taps, int k) const {
     const size_t row = static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_);
-    const float* t00 = texture_ + 3 * (row + static_cast<size_t>(taps.x0[k]));
-    const float* t10 = t00 + taps.step_x[k];
-    const float* t01 = t00 + taps.step_y[k];
-    const float* t11 = t01 + taps.step_x[k];
-    const float w00 = taps.w00[k], w10 = taps.w10[k], w01 = taps.w01[k], w11 = taps.w11[k];
-    // Four lanes per tap (RGB and the next pixel's R), except at the last pixel, which has
-    // no next one.
-    if (t11 + 3 < texture_end_) {
-      return w00 * Load4(t00) + w10 * Load4(t10) + w01 * Load4(t01) + w11 * Load4(t11);
-    }
-    F4 rgb{};
-    for (int c = 0; c < 3; ++c) rgb[c] = w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c];
-    return rgb;
+    const uint16_t* t00 = texture_ + 4 * (row + static_cast<size_t>(taps.x0[k]));
+    const uint16_t* t10 = t00 + taps.step_x[k];
+    const uint16_t* t01 = t00 + taps.step_y[k];
+    const uint16_t* t11 = t01 + taps.step_x[k];
+    return taps.w00[k] * LoadHalf4(t00) + taps.w10[k] * LoadHalf4(t10) +
+           taps.w01[k] * LoadHalf4(t01) + taps.w11[k] * LoadHalf4(t11);
   }
 
   // Where the target samples the source more densely than its pixels (magnified), and
   // between pixels generally, bilinear interpolation blurs the texture: Catmull-Rom over
-  // 4 x 4 source pixels keeps it sharper. Inside the image by at least one pixel, and a row
-  // above the last, so that the last tap's 4-lane load stays inside (the caller checks).
-  // Lane 3 undefined.
+  // 4 x 4 source pixels keeps it sharper. Inside the image by at least one pixel (the caller
+  // checks). Lane 3 is 0 (the texture's fourth channel).
   F4 Bicubic(float sx, float sy) const {
     const int x0 = static_cast<int>(sx), y0 = static_cast<int>(sy);
     float wx[4], wy[4];
@@ -479,10 +472,10 @@ class Rasterizer {
     CatmullRom(sy - static_cast<float>(y0), wy);
     F4 rgb{};
     for (int r = 0; r < 4; ++r) {
-      const float* row = texture_ + 3 * (static_cast<size_t>(y0 - 1 + r) * static_cast<size_t>(texture_width_) +
-                                         static_cast<size_t>(x0 - 1));
-      const F4 across = wx[0] * Load4(row) + wx[1] * Load4(row + 3) + wx[2] * Load4(row + 6) +
-                        wx[3] * Load4(row + 9);
+      const uint16_t* row = texture_ + 4 * (static_cast<size_t>(y0 - 1 + r) * static_cast<size_t>(texture_width_) +
+                                            static_cast<size_t>(x0 - 1));
+      const F4 across = wx[0] * LoadHalf4(row) + wx[1] * LoadHalf4(row + 4) +
+                        wx[2] * LoadHalf4(row + 8) + wx[3] * LoadHalf4(row + 12);
       rgb += wy[r] * across;
     }
     // The kernel's negative lobes can undershoot below black.
@@ -508,10 +501,9 @@ class Rasterizer {
   int height_;
   float* depth_;
   uint16_t* color_weight_;
-  const float* texture_;
+  const uint16_t* texture_;
   int texture_width_;
   int texture_height_;
-  const float* texture_end_;
 };
 
 

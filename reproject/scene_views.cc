@@ -48,7 +48,7 @@ std::vector<SourceView> ReadSourceViews(const ViewSetPaths& paths) {
     view.color = LinearRgb(ReadImage(paths.images / names[i]));
     view.depth = ReadDepthExr(paths.DepthFor(names[i]));
     CheckSourceView(view);
-    MarkSourceBackground(&view);
+    PrepareSource(&view);
     views.push_back(std::move(view));
   }
   return views;

@@ -34,12 +34,16 @@ struct SourceView {
   Rigid3d cam_from_world;
   Image color;     // Linear RGB, 3 channels, camera size.
   DepthMap depth;  // z-depth in scene units, 0 = no value; camera size.
+  // Made once per source by PrepareSource (forward_warp.h), after the depth and colour are
+  // final, instead of by every warp; when empty (or made with another step, or for another
+  // size), ForwardWarp makes its own.
   // Which depth-0 pixels are background at infinity: MarkBackground of depth and colour with
-  // background_step (see MarkSourceBackground in forward_warp.h). It depends on the source
-  // alone, so loaders mark it once, after the depth is final, instead of every warp doing it
-  // again; when empty or made with another step, ForwardWarp marks its own.
+  // background_step.
   std::vector<uint8_t> background;
   float background_step = 0;
+  // The colour as the warp samples it: four half floats per pixel (R, G, B, 0), 8 bytes to
+  // stream instead of 12 (the warps wait on this memory), one aligned load per tap.
+  std::vector<uint16_t> texture;
 
   PosedCamera Posed() const { return {camera, cam_from_world}; }
 };

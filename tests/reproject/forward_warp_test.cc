@@ -1,6 +1,7 @@
 #include "reproject/forward_warp.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -354,11 +355,12 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
         continue;
       }
       // Decode the direction the colour came from and compare in source pixels.
-      // Over the error of the colour's half rounding in pixels, plus 0.02.
+      // Over 0.02 pixels plus the error of the colour's half roundings in pixels (texture and
+      // warp buffer).
       const double red = result.color.At(x, y, 0), green = result.color.At(x, y, 1);
       const double du = 150 * (red - 0.5) / 0.4 - 150 * dir.x() / dir.z();
       const double dv = 150 * (green - 0.5) / 0.4 - 150 * dir.y() / dir.z();
-      const double rounding_px = 150 / 0.4 * WarpBuffer::kHalfRounding * std::hypot(red, green);
+      const double rounding_px = 150 / 0.4 * 2 * WarpBuffer::kHalfRounding * std::hypot(red, green);
       max_error_scaled = std::max(max_error_scaled, std::hypot(du, dv) / (0.02 + rounding_px));
     }
   }
@@ -370,8 +372,8 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
   for (float z : result.depth.Values()) ASSERT_TRUE(std::isfinite(z));
 }
 
-// A source's own background mask (MarkSourceBackground) warps exactly as the mask the warp
-// marks itself; a mask made with another colour step is not used.
+// A source's own background mask and texture (PrepareSource) warp exactly as those the warp
+// makes itself; a mask made with another colour step is not used.
 TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
   const Camera camera = TestCamera(160, 120, 150);
   const Scene scene = BoxInSky();
@@ -381,23 +383,29 @@ TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
     WarpBuffer buffer;
     WarpScratch scratch;
     ForwardWarp(view, target, {}, &buffer, &scratch);
-    return std::make_pair(std::vector<float>(buffer.Depths(), buffer.Depths() + buffer.Size()),
-                          scratch.Background());
+    std::vector<float> samples;  // Depth, colour and weight of every pixel with a sample.
+    for (size_t i = 0; i < buffer.Size(); ++i) {
+      if (buffer.Depth(i) == 0) continue;
+      const std::array<float, 3> rgb = buffer.Color(i);
+      samples.insert(samples.end(), {buffer.Depth(i), rgb[0], rgb[1], rgb[2], buffer.Weight(i)});
+    }
+    return std::make_pair(samples, scratch.Background());
   };
-  const auto [own_depth, own_mask] = warp(source);
+  const auto [own_samples, own_mask] = warp(source);
   ASSERT_GT(std::count(own_mask.begin(), own_mask.end(), 1), 160 * 120 / 2);
 
-  MarkSourceBackground(&source);
+  PrepareSource(&source);
   EXPECT_EQ(source.background, own_mask);
-  const auto [shared_depth, shared_mask] = warp(source);
-  EXPECT_EQ(shared_depth, own_depth);
+  ASSERT_EQ(source.texture.size(), 4u * 160 * 120);
+  const auto [shared_samples, shared_mask] = warp(source);
+  EXPECT_EQ(shared_samples, own_samples);
 
   // A stale mask (everything background) made with another step: the warp marks its own.
   std::fill(source.background.begin(), source.background.end(), uint8_t{1});
   source.background_step = 0.5f;
-  const auto [restep_depth, restep_mask] = warp(source);
+  const auto [restep_samples, restep_mask] = warp(source);
   EXPECT_EQ(restep_mask, own_mask);
-  EXPECT_EQ(restep_depth, own_depth);
+  EXPECT_EQ(restep_samples, own_samples);
 }
 
 // A warp drawn in bands of target rows in parallel gives what one band gives, bit for bit:
@@ -500,7 +508,7 @@ TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
   const Camera camera = TestCamera();
   const double f = camera.FocalX(), cx = camera.PrincipalX(), cy = camera.PrincipalY();
   const Eigen::Vector3d normal(0, 0.3, 0.25);  // The plane normal . X = 1 (source frame).
-  SourceView source{"slanted", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120), {}, 0};
+  SourceView source{"slanted", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120), {}, 0, {}};
   for (int y = 0; y < 120; ++y) {
     for (int x = 0; x < 160; ++x) {
       const Eigen::Vector3d ray((x + 0.5 - cx) / f, (y + 0.5 - cy) / f, 1);
@@ -526,9 +534,9 @@ TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
       const double sx = f * point.x() / point.z() + cx - 0.5;
       const double sy = f * point.y() / point.z() + cy - 0.5;
       if (sx < 1.5 || sy < 1.5 || sx > 157.5 || sy > 117.5) continue;
-      // Over 0.01 pixels plus the colour's half rounding in pixels.
+      // Over 0.01 pixels plus the colour's half roundings in pixels (texture and warp buffer).
       const double red = buffer.Color(i)[0], green = buffer.Color(i)[1];
-      const auto bound = [](double value) { return 0.01 + 256 * WarpBuffer::kHalfRounding * value; };
+      const auto bound = [](double value) { return 0.01 + 256 * 2 * WarpBuffer::kHalfRounding * value; };
       position_error_scaled = std::max({position_error_scaled, std::abs(red * 256 - sx) / bound(red),
                                  std::abs(green * 256 - sy) / bound(green)});
       const double z = buffer.Depth(i);

@@ -202,7 +202,7 @@ Eigen::Quaterniond RandomRotation(std::mt19937& random, double max_angle_rad) {
 // [0.2, 200], coloured with their own pixel coordinates so the target tells which landed.
 SourceView SparseLabelledSource(std::mt19937& random) {
   const Camera camera = MakePinholeCamera(1, 160, 120, 150, 140, 81.3, 58.7);
-  SourceView source{"sparse", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120), {}, 0};
+  SourceView source{"sparse", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120), {}, 0, {}};
   std::uniform_real_distribution<double> log_depth(std::log(0.2), std::log(200.0));
   for (int y = 1; y < 120; y += 4) {
     for (int x = 1; x < 160; x += 4) {
@@ -353,7 +353,7 @@ TEST(FloatReference, MeshWarpOfAPlaneAgreesWithDoubleRayCasting) {
   WarpBuffer buffer;
   for (int trial = 0; trial < 20; ++trial) {
     const RandomPlane plane = MakeRandomPlane(random);
-    SourceView source{"plane", camera, Rigid3d(), Image(96, 72, 3), DepthMap(96, 72), {}, 0};
+    SourceView source{"plane", camera, Rigid3d(), Image(96, 72, 3), DepthMap(96, 72), {}, 0, {}};
     for (int y = 0; y < 72; ++y) {
       for (int x = 0; x < 96; ++x) {
         source.depth.At(x, y) = static_cast<float>(PlaneDepth(plane, source_camera, x, y));
