@@ -234,8 +234,9 @@ class DepthAwareFiller {
 
  private:
   struct Step {
-    int dx, dy;     // Pixel offset.
-    ptrdiff_t di;   // The same as an index offset: dy * width + dx.
+    int dx, dy;      // Pixel offset.
+    ptrdiff_t di;    // The same as an index offset: dy * width + dx.
+    float distance;  // Steps of one pixel that reach the pixel first.
   };
 
   size_t Index(int x, int y) const {
@@ -254,13 +255,14 @@ class DepthAwareFiller {
   bool Find(int k, int x, int y, const RowSamples& row, Candidate* out) const {
     if (k == 0) return InRow(x, y, row.right, out);
     if (2 * k == count_) return InRow(x, y, row.left, out);
-    return March(x, y, &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)], out);
+    const auto direction = static_cast<size_t>(k);
+    return March(x, y, &steps_[direction * static_cast<size_t>(max_steps_)], step_counts_[direction], out);
   }
 
-  // `steps`: the direction's pixel offsets (MeasureSteps).
-  bool March(int x, int y, const Step* steps, Candidate* out) const {
+  // `steps`: the direction's `count` pixel offsets (MeasureSteps).
+  bool March(int x, int y, const Step* steps, int count, Candidate* out) const {
     const auto start = static_cast<ptrdiff_t>(Index(x, y));
-    for (int step = 1; step < max_steps_; ++step) {
+    for (int step = 1; step < count; ++step) {
       // Unsigned, a negative coordinate is past the width too: one test per axis.
       const auto ix = static_cast<unsigned>(x + steps[step].dx);
       const auto iy = static_cast<unsigned>(y + steps[step].dy);
@@ -275,7 +277,7 @@ class DepthAwareFiller {
         if (distance > 1) step += kBlock * distance - 5;
         continue;
       }
-      CandidateAt(j, static_cast<float>(step), out);
+      CandidateAt(j, steps[step].distance, out);
       return true;
     }
     return false;  // Past the last step, outside the image from any pixel.
@@ -297,23 +299,28 @@ class DepthAwareFiller {
     out->rgb = blend_.color.Pixels().data() + 3 * j;
   }
 
-  // steps_: per direction k, the pixel reached after s steps of one pixel from a pixel's
-  // centre, as an offset from the pixel: (floor(0.5 + s cos), floor(0.5 + s sin)), the same
-  // from every pixel. A march then reads a table instead of stepping in float. After
-  // max_steps_ steps a march has left the image whichever pixel it started from (every
-  // direction moves at least cos(45 deg) of a pixel per step along one axis).
+  // steps_: per direction k, the pixels reached by steps of one pixel from a pixel's centre,
+  // as offsets from the pixel: after s steps (floor(0.5 + s cos), floor(0.5 + s sin)), the
+  // same from every pixel, each pixel once (a diagonal reaches one every 1.4 steps), with
+  // the step that reaches it first; step_counts_[k] of them. A march then reads a table
+  // instead of stepping in float, and tests each pixel once. After max_steps_ steps a march
+  // has left the image whichever pixel it started from (every direction moves at least
+  // cos(45 deg) of a pixel per step along one axis).
   void MeasureSteps() {
     max_steps_ = static_cast<int>(std::ceil(std::max(width_, height_) * std::sqrt(2.0))) + 2;
     steps_.resize(static_cast<size_t>(count_) * static_cast<size_t>(max_steps_));
+    step_counts_.assign(static_cast<size_t>(count_), 0);
     for (int k = 0; k < count_; ++k) {
       const double angle = 2 * kPi * k / count_;
       const auto dx = static_cast<float>(std::cos(angle)), dy = static_cast<float>(std::sin(angle));
       Step* steps = &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)];
+      int& count = step_counts_[static_cast<size_t>(k)];
       for (int s = 0; s < max_steps_; ++s) {
         const auto fs = static_cast<float>(s);
         const int step_x = static_cast<int>(std::floor(0.5f + fs * dx));
         const int step_y = static_cast<int>(std::floor(0.5f + fs * dy));
-        steps[s] = {step_x, step_y, static_cast<ptrdiff_t>(step_y) * width_ + step_x};
+        if (count > 0 && steps[count - 1].dx == step_x && steps[count - 1].dy == step_y) continue;
+        steps[count++] = {step_x, step_y, static_cast<ptrdiff_t>(step_y) * width_ + step_x, fs};
       }
     }
   }
@@ -371,6 +378,7 @@ class DepthAwareFiller {
   int hole_sky_directions_;
   int max_steps_ = 0;
   std::vector<Step> steps_;
+  std::vector<int> step_counts_;
   int blocks_x_ = 0;
   std::vector<uint16_t> distance_;
 };
