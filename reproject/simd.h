@@ -107,14 +107,12 @@ inline U4 HalfBitsPortable(F4 value) {
 
 inline F4 FromHalfBitsPortable(U4 half) {
   const U4 sign = (half & 0x8000u) << 16;
-  const U4 exponent = half & 0x7c00u;
-  const U4 shifted = (half & 0x7fffu) << 13;
-  // Rebias the exponent (15 -> 127); infinity and NaN keep the largest one, and zero and
-  // subnormals (exponent 0) are their mantissa times 2^-24, as the float 2^-14 (1 + m) - 2^-14.
-  const U4 normal = shifted + ((127u - 15u) << 23);
-  const U4 special = normal + ((128u - 16u) << 23);
-  const F4 subnormal = FromBits(shifted + (113u << 23)) - FromBits(U4{} + (113u << 23));
-  const U4 magnitude = exponent == 0x7c00u ? special : exponent == 0 ? Bits(subnormal) : normal;
+  const U4 shifted = (half & 0x7fffu) << 13;  // Exponent and mantissa where a float has them.
+  // Read as a float, that is the half with the exponent's bias 127 instead of 15: times 2^112
+  // it is the half's value, exactly (subnormals, exponent 0, come out normal). Infinity and
+  // NaN (exponent 31) take the float's largest exponent instead.
+  const F4 scaled = FromBits(shifted) * 0x1p112f;
+  const U4 magnitude = shifted >= (0x7c00u << 13) ? shifted | 0x7f800000u : Bits(scaled);
   return FromBits(magnitude | sign);
 }
 
