@@ -147,11 +147,16 @@ void BlendRow(std::span<const WarpBuffer> buffers, int y, float tolerance, int m
     const F4 sum = Load4(rgbw_sum + 4 * x);
     const float weight = sum[3];
     const bool surface = front[x] != WarpBuffer::kBackground;
-    const bool blended = (surface || any_background[x] != 0.0f) && weight > 0 && weight <= kFloatMax;
-    const float inv = blended ? 1.0f / weight : 0.0f;
+    if ((!surface && any_background[x] == 0.0f) || !(weight > 0) || !(weight <= kFloatMax)) {
+      for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = 0.0f;
+      depth_out[x] = 0.0f;
+      kind_out[x] = SampleKind::kNone;
+      continue;
+    }
+    const float inv = 1.0f / weight;
     for (size_t k = 0; k < 3; ++k) rgb_out[3 * x + k] = sum[k] * inv;
     depth_out[x] = surface ? depth_sum[x] * inv : 0.0f;
-    kind_out[x] = !blended ? SampleKind::kNone : surface ? SampleKind::kSurface : SampleKind::kBackground;
+    kind_out[x] = surface ? SampleKind::kSurface : SampleKind::kBackground;
   }
 }
 
