@@ -259,8 +259,10 @@ class DepthAwareFiller {
     return March(x, y, &steps_[direction * static_cast<size_t>(max_steps_)], step_counts_[direction], out);
   }
 
-  // `steps`: the direction's `count` pixel offsets (MeasureSteps).
-  bool March(int x, int y, const Step* steps, int count, Candidate* out) const {
+  // `steps`: the direction's `count` pixel offsets (MeasureSteps). Not inlined: inside
+  // FillRow, with more live there than registers, the loop kept its state on the stack (K=4
+  // render 1920x1080: fill 13.8-14.4 -> 12.9-13.3 ms).
+  [[gnu::noinline]] bool March(int x, int y, const Step* steps, int count, Candidate* out) const {
     const auto start = static_cast<ptrdiff_t>(Index(x, y));
     for (int step = 1; step < count; ++step) {
       // Unsigned, a negative coordinate is past the width too: one test per axis.
