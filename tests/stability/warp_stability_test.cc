@@ -318,5 +318,40 @@ TEST(WarpStability, DepthDiscontinuityOfAMillionIsAHoleNeverBridged) {
   }
 }
 
+TEST(WarpStability, ColoursBeyondHalfFloatsSaturateAndTinyOnesStayFinite) {
+  // The warp keeps colour in half floats (largest finite 65504, smallest subnormal 6e-8).
+  // A wall whose left half is brighter than a half can hold (1e6, a sun in an EXR), HDR
+  // (1000) and nearly black (1e-9), the right half ordinary: every output stays finite, the
+  // overbright channel saturates at 65504 instead of turning into infinity, and the rest
+  // keep their values within the half's rounding.
+  Scene scene;
+  scene.planes.push_back(test::WallAt(5, [](const Eigen::Vector3d& p) {
+    return p.x() < 0 ? Eigen::Vector3f(1e6f, 1000.0f, 1e-9f) : Eigen::Vector3f(0.5f, 0.25f, 0.0f);
+  }));
+  const SourceView source = test::RenderView(scene, CameraAt(WarpCamera(), {0, 0, 0}));
+  const PosedCamera target = CameraAt(WarpCamera(), {0.2, 0.1, 0.5});
+  for (const WarpMethod method : kMethods) {
+    SCOPED_TRACE(Name(method));
+    const RenderResult result = RenderUnfilled(source, target, method);
+    long bright = 0;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(result.color.At(x, y, c)));
+        if (result.classes.At(x, y) != PixelClass::kCovered) continue;
+        // World x of the pixel's point on the wall, away from the seam.
+        const Eigen::Vector3d ray = test::PixelRay(target, x, y);
+        const double wall_x = 0.2 + ray.x() * (5 - 0.5) / ray.z();
+        if (wall_x > -0.1) continue;
+        ++bright;
+        EXPECT_NEAR(result.color.At(x, y, 0), 65504.0, 65504.0 * 2 * WarpBuffer::kHalfRounding);
+        EXPECT_NEAR(result.color.At(x, y, 1), 1000.0, 1000.0 * 2 * WarpBuffer::kHalfRounding);
+        EXPECT_GE(result.color.At(x, y, 2), 0.0f);
+        EXPECT_LE(result.color.At(x, y, 2), 1e-7f);
+      }
+    }
+    EXPECT_GT(bright, kPixels / 4);
+  }
+}
+
 }  // namespace
 }  // namespace parallax
