@@ -149,6 +149,11 @@ nlohmann::json EvaluateNovel(const SceneFolder& scene, const std::filesystem::pa
   const NovelEvaluation result =
       EvaluateNovelViews(library, targets, names, scene.Novel(), settings.selection,
                          settings.render, comparison_dir);
+  std::printf("%-16s %9s %7s %14s %7s\n", "novel view", "PSNR (dB)", "SSIM", "sampled (dB)", "holes");
+  for (const NovelViewScore& view : result.per_view) {
+    std::printf("%-16s %9.2f %7.3f %14.2f %6.2f%%\n", view.name.c_str(), view.psnr, view.ssim,
+                view.psnr_valid, 100 * view.hole_ratio);
+  }
   std::printf("novel views (%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels), SSIM %.3f; "
               "holes %.2f%% (cracks %.2f%%) -> %.2f%% after filling; out of view %.2f%%, "
               "background %.2f%%; %.1f ms per view; %d of %d sources loaded (%s)\n",

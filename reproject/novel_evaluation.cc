@@ -65,9 +65,12 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
       sampled[p] = c == PixelClass::kCovered || c == PixelClass::kBackground;
     }
     const HoleMetrics& metrics = view.result.metrics;
-    evaluation.psnr_mean += Psnr(render, truth_image);
-    evaluation.ssim_mean += Ssim(render, truth_image);
-    evaluation.psnr_valid_mean += Psnr(render, truth_image, sampled);
+    const NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
+                               Psnr(render, truth_image, sampled), metrics.hole_ratio};
+    evaluation.per_view.push_back(score);
+    evaluation.psnr_mean += score.psnr;
+    evaluation.ssim_mean += score.ssim;
+    evaluation.psnr_valid_mean += score.psnr_valid;
     evaluation.hole_ratio_mean += metrics.hole_ratio;
     evaluation.crack_ratio_mean += metrics.crack_ratio;
     evaluation.out_of_view_ratio_mean += metrics.out_of_view_ratio;

@@ -2,6 +2,7 @@
 // Novel views against ground truth (DESIGN.md evaluate JSON, "novel" section): each held-out
 // camera rendered from the sources and compared with its real image.
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "core/scene_folder.h"
@@ -9,7 +10,17 @@
 
 namespace parallax {
 
+// One novel view's scores (as the means below).
+struct NovelViewScore {
+  std::string name;
+  double psnr = 0;
+  double ssim = 0;
+  double psnr_valid = 0;
+  double hole_ratio = 0;
+};
+
 struct NovelEvaluation {
+  std::vector<NovelViewScore> per_view;  // In the order of the targets.
   int views = 0;
   double psnr_mean = 0;        // All pixels, after filling (sRGB in [0, 1]).
   double ssim_mean = 0;        // All pixels, after filling.
