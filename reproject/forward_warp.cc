@@ -266,12 +266,10 @@ void MakeTexture(const Image& color, std::vector<uint16_t>* texture) {
   texture->resize(4 * count);
   const float* rgb = color.Pixels().data();
   uint16_t* out = texture->data();
-  constexpr float kMax = WarpBuffer::kMaxHalf;
+  const simd::F4 low = simd::F4{} - WarpBuffer::kMaxHalf;
   for (size_t i = 0; i < count; ++i) {
-    simd::F4 value = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2], 0.0f};
-    value = value > -kMax ? value : simd::F4{} - kMax;
-    value = value < kMax ? value : simd::F4{} + kMax;
-    simd::StoreHalf4(out + 4 * i, value);
+    const simd::F4 value = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2], 0.0f};
+    warp_internal::StoreHalf4Clamped(out + 4 * i, value, low);
   }
 }
 
