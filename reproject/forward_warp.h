@@ -156,7 +156,8 @@ class WarpScratch {
 // Makes what every warp of the source would otherwise make again, for the warps to share:
 // source->texture, and source->background (MarkBackground of its depth and colour, with the
 // options' background_max_step) where the options warp background at infinity. Call again
-// whenever the depth or colour changes.
+// whenever the depth or colour changes. Throws std::invalid_argument for a source
+// CheckSourceView refuses or bad options.
 void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {});
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or

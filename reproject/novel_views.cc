@@ -181,7 +181,6 @@ const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp)
     }
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
-    CheckSourceView(*view);
     PrepareSource(view.get(), warp);
     slot = std::move(view);
   }

@@ -47,7 +47,6 @@ std::vector<SourceView> ReadSourceViews(const ViewSetPaths& paths) {
     view.cam_from_world = cameras[i].cam_from_world;
     view.color = LinearRgb(ReadImage(paths.images / names[i]));
     view.depth = ReadDepthExr(paths.DepthFor(names[i]));
-    CheckSourceView(view);
     PrepareSource(&view);
     views.push_back(std::move(view));
   }
