@@ -11,7 +11,7 @@
 namespace parallax {
 namespace {
 
-// Exit codes of DESIGN.md.
+// Exit codes of docs/design.md.
 constexpr int kExitUsage = 1;
 constexpr int kExitBadInput = 2;
 constexpr int kExitToolFailed = 3;

@@ -1,23 +1,16 @@
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <map>
 #include <memory>
-#include <numbers>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
-#include "core/error.h"
-#include "core/image.h"
-#include "viewer/egl_context.h"
-#include "viewer/renderer.h"
-#include "viewer/shadow_reference.h"
+#include "eval/shadow_reference.h"
+#include "viewer/screenshot.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 #include "viewer/viewer_scene.h"
@@ -84,94 +77,36 @@ FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
   return settings;
 }
 
-std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name) {
-  if (name.empty()) return std::nullopt;
-  SourceViewCamera(scene, name);  // Throws with the known names when there is none.
-  for (size_t i = 0; i < scene.sources.size(); ++i) {
-    if (scene.sources[i].name == name || std::filesystem::path(scene.sources[i].name).stem() == name) {
-      return static_cast<int>(i);
-    }
-  }
-  return std::nullopt;
-}
-
-// The median and fastest of `frames` frames, each finished with glFinish; `before_frame(i)` may
-// change the settings first.
-template <typename BeforeFrame>
-std::pair<double, double> TimeFrames(SceneRenderer& renderer, const ViewCamera& view, FrameSettings settings,
-                                     int frames, const BeforeFrame& before_frame) {
-  std::vector<double> ms;
-  for (int i = 0; i < frames; ++i) {
-    before_frame(i, settings);
-    const auto start = std::chrono::steady_clock::now();
-    renderer.Draw(view, settings);
-    renderer.Finish();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return {ms[ms.size() / 2], ms[0]};
-}
-
-// Draws `frames` more frames of the same view and prints the median and the fastest: the frame
-// time of the interactive viewer holding still. With a shadow map, again with the light moving
-// a little every frame, so the map is re-rendered each time.
-void PrintFrameTimes(SceneRenderer& renderer, const ViewCamera& view, const FrameSettings& settings, int frames) {
-  const auto [median, fastest] = TimeFrames(renderer, view, settings, frames, [](int, FrameSettings&) {});
-  std::printf("frame time over %d frames (%dx%d): median %.1f ms, min %.1f ms\n", frames,
-              static_cast<int>(view.camera.width), static_cast<int>(view.camera.height), median, fastest);
-  if (settings.shadows != ShadowMode::kMap && settings.shadows != ShadowMode::kPcf) return;
-  const auto [moving, moving_fastest] = TimeFrames(renderer, view, settings, frames, [&](int i, FrameSettings& s) {
-    // A tenth of a degree back and forth about the z axis: a new map every frame.
-    const Eigen::AngleAxisd turn((i % 2 == 0 ? 1 : -1) * 0.1 * std::numbers::pi / 180, Eigen::Vector3d::UnitZ());
-    s.light.position = turn * settings.light.position;
-    s.light.direction = turn * settings.light.direction;
-  });
-  std::printf("frame time with the light moving (shadow map re-rendered): median %.1f ms, min %.1f ms\n", moving,
-              moving_fastest);
-}
-
-// The frame's shadow mask against Embree's exact one for the mesh it drew.
-void PrintShadowAccuracy(const TexturedMesh& drawn, const ViewCamera& view, const FrameSettings& settings,
-                         const FrameResult& frame) {
-  if (settings.light.type != LightKind::kDirectional || drawn.triangles.empty()) {
-    throw BadInputError("--shadow-iou needs a directional light and a mesh");
-  }
-  const std::vector<ReferencePixel> reference = ReferenceShadows(drawn, view, settings.light.direction);
-  const MaskComparison mask = CompareShadowMasks(reference, frame.aux);
-  const MaskComparison cast = CompareCastShadows(reference, frame.aux);
-  std::printf("shadow IoU against Embree ray tracing: %.4f (%d rendered, %d ray-traced shadowed of %d pixels); "
-              "cast shadows alone: %.4f (%d / %d of %d pixels facing the light)\n",
-              mask.iou, mask.rendered_shadowed, mask.reference_shadowed, mask.compared, cast.iou,
-              cast.rendered_shadowed, cast.reference_shadowed, cast.compared);
-}
-
-void TakeScreenshot(const ViewArguments& a, const ViewerScene& scene, const FrameSettings& settings) {
-  const std::optional<std::pair<int, int>> size =
-      a.size.empty() ? std::nullopt : std::optional(ParseSize(a.size));
-  ViewCamera view;
-  if (!a.camera.empty()) {
-    view = SourceViewCamera(scene, a.camera);
-    if (size) view = ScaledSourceViewCamera(scene.sources[*SourceIndex(scene, a.camera)], size->first, size->second);
-  } else {
-    const auto [width, height] = size.value_or(std::pair{1280, 720});
-    view = OrbitViewCamera(scene, a.orbit_deg.value_or(30), a.elevation_deg, width, height, a.fov_deg);
-  }
-  const HeadlessGlContext context;
-  SceneRenderer renderer(scene);
-  const auto start = std::chrono::steady_clock::now();
-  const FrameResult result = renderer.Render(view, settings);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  for (const std::string& note : renderer.TakeNotes()) std::fprintf(stderr, "note: %s\n", note.c_str());
-  WriteImage(a.screenshot, result.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
-  std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), result.colour.Width(),
-              result.colour.Height(), ms);
-  const TexturedMesh& drawn = DisplayedMesh(scene, result.colour.Width(), result.colour.Height());
-  if (&drawn == &scene.display_mesh) {
-    std::printf("level of detail: the display mesh, %zu of %zu triangles\n", drawn.triangles.size(),
+void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const FrameSettings& settings) {
+  ScreenshotOptions options{a.screenshot, a.camera, a.orbit_deg, a.elevation_deg, a.fov_deg,
+                            a.size.empty() ? std::nullopt : std::optional(ParseSize(a.size)),
+                            a.timed_frames};
+  const Screenshot shot = TakeScreenshot(scene, settings, options);
+  for (const std::string& note : shot.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
+  std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), shot.frame.colour.Width(),
+              shot.frame.colour.Height(), shot.ms);
+  if (shot.display_mesh) {
+    std::printf("level of detail: the display mesh, %zu of %zu triangles\n", shot.drawn->triangles.size(),
                 scene.mesh.triangles.size());
   }
-  if (a.shadow_iou) PrintShadowAccuracy(drawn, view, settings, result);
-  if (a.timed_frames > 0) PrintFrameTimes(renderer, view, settings, a.timed_frames);
+  if (a.shadow_iou) {
+    const ShadowAccuracy accuracy = MeasureShadowAccuracy(*shot.drawn, shot.view, settings, shot.frame);
+    const MaskComparison& mask = accuracy.all;
+    const MaskComparison& cast = accuracy.cast;
+    std::printf("shadow IoU against Embree ray tracing: %.4f (%d rendered, %d ray-traced shadowed of %d pixels); "
+                "cast shadows alone: %.4f (%d / %d of %d pixels facing the light)\n",
+                mask.iou, mask.rendered_shadowed, mask.reference_shadowed, mask.compared, cast.iou,
+                cast.rendered_shadowed, cast.reference_shadowed, cast.compared);
+  }
+  if (!shot.times) return;
+  const FrameTimes& times = *shot.times;
+  std::printf("frame time over %d frames (%dx%d): median %.1f ms, min %.1f ms\n", times.frames,
+              static_cast<int>(shot.view.camera.width), static_cast<int>(shot.view.camera.height),
+              times.median_ms, times.min_ms);
+  if (times.moving_median_ms) {
+    std::printf("frame time with the light moving (shadow map re-rendered): median %.1f ms, min %.1f ms\n",
+                *times.moving_median_ms, *times.moving_min_ms);
+  }
 }
 
 }  // namespace
@@ -225,7 +160,7 @@ void RegisterViewCommand(CLI::App& app) {
     const ViewerScene scene = LoadViewerScene(a->workspace);
     const FrameSettings settings = Settings(*a, scene);
     if (!a->screenshot.empty()) {
-      TakeScreenshot(*a, scene, settings);
+      PrintScreenshot(*a, scene, settings);
       return;
     }
     WindowOptions options;

@@ -7,7 +7,7 @@
 #include <benchmark/benchmark.h>
 
 #include "core/camera.h"
-#include "pipeline/patch_match.h"
+#include "mvs/patch_match.h"
 
 namespace parallax {
 namespace {

@@ -1,6 +1,6 @@
 #pragma once
 // Exceptions thrown at the boundaries of parallax. The CLI maps each to an exit code
-// (DESIGN.md): usage 1, bad input 2, external tool 3.
+// (docs/design.md): usage 1, bad input 2, external tool 3.
 #include <stdexcept>
 #include <string>
 

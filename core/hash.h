@@ -2,6 +2,7 @@
 // Content hashes for the stage cache: FNV-1a, 64-bit. Not cryptographic; it detects changed
 // inputs and options, which is all the cache needs.
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -27,6 +28,10 @@ class Hasher {
  private:
   uint64_t state_ = 0xcbf29ce484222325ull;
 };
+
+// The names and contents of the regular files in `dir`, in name order. Throws BadInputError
+// naming a file that cannot be read.
+uint64_t HashFolder(const std::filesystem::path& dir);
 
 // Murmur3's 64-bit finaliser: every input bit reaches every output bit. Deterministic
 // pseudo-random numbers keyed by coordinates (procedural textures, PatchMatch proposals)

@@ -1,5 +1,5 @@
 #pragma once
-// Image quality against a reference, as DESIGN.md's evaluate JSON defines it: on sRGB values
+// Image quality against a reference, as docs/design.md's evaluate JSON defines it: on sRGB values
 // in [0, 1], colour channels only (alpha ignored).
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Paths of the scene-folder layout (DESIGN.md): what `synth` writes and `evaluate` reads.
+// Paths of the scene-folder layout (docs/design.md): what `synth` writes and `evaluate` reads.
 #include <filesystem>
 #include <string>
 
@@ -20,6 +20,8 @@ struct SceneFolder {
   std::filesystem::path root;
 
   std::filesystem::path SceneJson() const { return root / "scene.json"; }
+  // Present in a scene folder, absent from a workspace.
+  std::filesystem::path GroundTruth() const { return root / "gt"; }
   ViewSetPaths Training() const;
   ViewSetPaths Novel() const;
 };

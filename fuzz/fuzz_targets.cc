@@ -10,8 +10,9 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
-#include "pipeline/ply.h"
-#include "pipeline/textured_mesh.h"
+#include "core/workspace.h"
+#include "geometry/ply.h"
+#include "geometry/textured_mesh.h"
 #include "synth/scene.h"
 
 namespace parallax::fuzz {
@@ -51,8 +52,8 @@ const fs::path& Scratch() {
     fs::create_directories(path);
     WriteSparseModel(TinyModel(), path / "binary", SparseFormat::kBinary);
     WriteSparseModel(TinyModel(), path / "text", SparseFormat::kText);
-    WriteFileAtomically(path / "mesh" / "mesh.mtl", "newmtl atlas\nmap_Kd mesh.png\n");
-    WriteImage(path / "mesh" / "mesh.png", Image(2, 2, 3), PixelFormat::kUint8);
+    WriteFileAtomically(Workspace(path).MeshDir() / "mesh.mtl", "newmtl atlas\nmap_Kd mesh.png\n");
+    WriteImage(Workspace(path).MeshDir() / "mesh.png", Image(2, 2, 3), PixelFormat::kUint8);
     return path;
   }();
   return dir;
@@ -107,7 +108,7 @@ void Ply(const uint8_t* data, size_t size) {
 }
 
 void Obj(const uint8_t* data, size_t size) {
-  const fs::path file = Put(Scratch() / "mesh" / "mesh.obj", data, size);
+  const fs::path file = Put(Workspace(Scratch()).Mesh(), data, size);
   Expect([&] { ReadTexturedMesh(file); });
 }
 

@@ -1,18 +1,21 @@
 #pragma once
-// `parallax reconstruct`, structure-from-motion part: photos -> COLMAP features, matches,
-// mapping (or triangulation with known cameras) -> undistorted PINHOLE workspace
-// (DESIGN.md "Workspace"), with a plausibility check and <ws>/report.json.
+// `parallax reconstruct`: photos -> COLMAP features, matches, mapping (or triangulation with
+// known cameras) -> undistorted PINHOLE workspace (docs/design.md "Workspace"), checked for
+// plausibility -> depth maps -> fused cloud -> textured mesh, each a cached stage of one
+// graph (pipeline/stage_graph.h); what each stage did goes to <ws>/report.json.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "core/camera.h"
 #include "core/progress.h"
-#include "pipeline/photo_set.h"
-#include "pipeline/plausibility.h"
-#include "pipeline/quality.h"
+#include "core/quality.h"
+#include "mesh/poisson.h"
+#include "mvs/mvs.h"
+#include "pipeline/stage_graph.h"
+#include "sfm/photo_set.h"
+#include "sfm/plausibility.h"
 
 namespace parallax {
 
@@ -30,7 +33,7 @@ enum class StereoMethod { kPatchMatch, kSgbm };
 struct ReconstructOptions {
   Quality quality = Quality::kBalanced;
   MatcherChoice matcher = MatcherChoice::kAuto;
-  // Single-focal by default: free fx/fy drift on rings of cameras (DESIGN.md pitfalls).
+  // Single-focal by default: free fx/fy drift on rings of cameras (docs/design.md pitfalls).
   CameraModel camera_model = CameraModel::kSimpleRadial;
   // Known intrinsics, held fixed in bundle adjustment: {f} (principal point at the image
   // centre) or {fx, fy, cx, cy}. Empty: estimated.
@@ -70,13 +73,6 @@ struct ReconstructOptions {
   void Check() const;  // Throws std::invalid_argument naming the field.
 };
 
-struct StageRecord {
-  std::string name;
-  bool skipped = false;
-  std::string reason;  // Why it was skipped (or will run, in a dry run).
-  double seconds = 0;
-};
-
 struct ReconstructSummary {
   std::vector<StageRecord> stages;
   std::vector<SkippedFile> skipped_files;
@@ -90,10 +86,10 @@ struct ReconstructSummary {
   double mean_track_length = 0;
   double mean_reprojection_error_px = 0;
   PlausibilityReport plausibility;
-  // Multi-view stereo per view: source views chosen, depth range, valid shares (JSON, as
-  // written to <ws>/depth/views.json); null when depth was not estimated.
-  nlohmann::json depth_views;
-  nlohmann::json mesh;  // pipeline/mesh.h's MeshSummary; null when no mesh was built.
+  // Multi-view stereo per view: source views chosen, depth range, valid shares (as written
+  // to <ws>/depth/views.json); absent when depth was not estimated.
+  std::optional<MvsSummary> depth;
+  std::optional<MeshSummary> mesh;  // Absent when no mesh was built.
   std::vector<std::string> notes;  // Decisions worth knowing (e.g. a refinement kept or not).
   std::vector<std::string> warnings;
 };

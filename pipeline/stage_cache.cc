@@ -22,6 +22,12 @@ bool StageCache::IsDone(const std::string& stage, const std::string& key) const 
   return found != keys_.end() && found->second == key;
 }
 
+std::optional<std::string> StageCache::KeyOf(const std::string& stage) const {
+  const auto found = keys_.find(stage);
+  if (found == keys_.end()) return std::nullopt;
+  return found->second;
+}
+
 void StageCache::MarkDone(const std::string& stage, const std::string& key) {
   keys_[stage] = key;
   WriteFileAtomically(file_, nlohmann::json(keys_).dump(2) + "\n");

@@ -5,6 +5,7 @@
 // recorded its key, so it runs again.
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 
 namespace parallax {
@@ -15,6 +16,8 @@ class StageCache {
   explicit StageCache(std::filesystem::path file);
 
   bool IsDone(const std::string& stage, const std::string& key) const;
+  // The key `stage` last completed with, if any.
+  std::optional<std::string> KeyOf(const std::string& stage) const;
   // Records the stage as complete and writes the file atomically.
   void MarkDone(const std::string& stage, const std::string& key);
 

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "reproject/simd.h"
+#include "core/check.h"
 
 namespace parallax {
 namespace {
@@ -163,14 +164,9 @@ void BlendRow(std::span<const WarpBuffer> buffers, int y, float tolerance, int m
 }  // namespace
 
 void BlendOptions::Check() const {
-  if (!(depth_tolerance > 0 && depth_tolerance < 1)) {
-    throw std::invalid_argument("BlendOptions.depth_tolerance = " +
-                                std::to_string(depth_tolerance) + ": expected (0, 1)");
-  }
-  if (min_support < 1 || min_support > 16) {
-    throw std::invalid_argument("BlendOptions.min_support = " + std::to_string(min_support) +
-                                ": expected [1, 16]");
-  }
+  RequireOption(depth_tolerance > 0 && depth_tolerance < 1, "BlendOptions.depth_tolerance", depth_tolerance,
+                "(0, 1)");
+  RequireOption(min_support >= 1 && min_support <= 16, "BlendOptions.min_support", min_support, "[1, 16]");
 }
 
 void Blend(std::span<const WarpBuffer> buffers, const BlendOptions& options, BlendResult* out) {

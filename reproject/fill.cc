@@ -16,6 +16,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/check.h"
+
 namespace parallax {
 namespace {
 
@@ -433,22 +435,12 @@ int FillInpaint(const ClassMap& classes, const FillOptions& options, BlendResult
 }  // namespace
 
 void FillOptions::Check() const {
-  if (directions != 8 && directions != 16) {
-    throw std::invalid_argument("FillOptions.directions = " + std::to_string(directions) +
-                                ": expected 8 or 16");
-  }
-  if (!(background_tolerance > 0 && background_tolerance < 1)) {
-    throw std::invalid_argument("FillOptions.background_tolerance = " +
-                                std::to_string(background_tolerance) + ": expected (0, 1)");
-  }
-  if (!(hole_sky_share > 0 && hole_sky_share <= 1)) {
-    throw std::invalid_argument("FillOptions.hole_sky_share = " + std::to_string(hole_sky_share) +
-                                ": expected (0, 1]");
-  }
-  if (!(inpaint_radius_px > 0 && std::isfinite(inpaint_radius_px))) {
-    throw std::invalid_argument("FillOptions.inpaint_radius_px = " +
-                                std::to_string(inpaint_radius_px) + ": expected > 0");
-  }
+  RequireOption(directions == 8 || directions == 16, "FillOptions.directions", directions, "8 or 16");
+  RequireOption(background_tolerance > 0 && background_tolerance < 1, "FillOptions.background_tolerance",
+                background_tolerance, "(0, 1)");
+  RequireOption(hole_sky_share > 0 && hole_sky_share <= 1, "FillOptions.hole_sky_share", hole_sky_share, "(0, 1]");
+  RequireOption(inpaint_radius_px > 0 && std::isfinite(inpaint_radius_px), "FillOptions.inpaint_radius_px",
+                inpaint_radius_px, "> 0");
 }
 
 FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillOptions& options,

@@ -17,6 +17,7 @@
 #include "reproject/background.h"
 #include "reproject/rasterizer.h"
 #include "reproject/simd.h"
+#include "core/check.h"
 
 namespace parallax {
 namespace {
@@ -663,26 +664,18 @@ class SourceWarper {
 }  // namespace
 
 void ForwardWarpOptions::Check() const {
-  const auto fail = [](const std::string& field, double value, const std::string& expected) {
-    throw std::invalid_argument("ForwardWarpOptions." + field + " = " + std::to_string(value) +
-                                ": expected " + expected);
-  };
-  if (!(max_slant_deg > 0 && max_slant_deg < 90)) fail("max_slant_deg", max_slant_deg, "(0, 90)");
-  if (!(max_splat_px >= 1 && max_splat_px <= 64)) fail("max_splat_px", max_splat_px, "[1, 64]");
-  if (!(splat_overlap >= 1 && splat_overlap <= 2)) fail("splat_overlap", splat_overlap, "[1, 2]");
-  if (!(min_view_cos > 0 && min_view_cos < 1)) fail("min_view_cos", min_view_cos, "(0, 1)");
-  if (!(background_max_step > 0 && std::isfinite(background_max_step))) {
-    fail("background_max_step", background_max_step, "> 0");
-  }
-  if (!(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad))) {
-    fail("angle_epsilon_rad", angle_epsilon_rad, "> 0");
-  }
-  if (!(silhouette_angle_rad >= 0 && std::isfinite(silhouette_angle_rad))) {
-    fail("silhouette_angle_rad", silhouette_angle_rad, ">= 0");
-  }
-  if (!(outline_splat_share > 0 && outline_splat_share <= 1)) {
-    fail("outline_splat_share", outline_splat_share, "(0, 1]");
-  }
+  RequireOption(max_slant_deg > 0 && max_slant_deg < 90, "ForwardWarpOptions.max_slant_deg", max_slant_deg, "(0, 90)");
+  RequireOption(max_splat_px >= 1 && max_splat_px <= 64, "ForwardWarpOptions.max_splat_px", max_splat_px, "[1, 64]");
+  RequireOption(splat_overlap >= 1 && splat_overlap <= 2, "ForwardWarpOptions.splat_overlap", splat_overlap, "[1, 2]");
+  RequireOption(min_view_cos > 0 && min_view_cos < 1, "ForwardWarpOptions.min_view_cos", min_view_cos, "(0, 1)");
+  RequireOption(background_max_step > 0 && std::isfinite(background_max_step),
+                "ForwardWarpOptions.background_max_step", background_max_step, "> 0");
+  RequireOption(angle_epsilon_rad > 0 && std::isfinite(angle_epsilon_rad), "ForwardWarpOptions.angle_epsilon_rad",
+                angle_epsilon_rad, "> 0");
+  RequireOption(silhouette_angle_rad >= 0 && std::isfinite(silhouette_angle_rad),
+                "ForwardWarpOptions.silhouette_angle_rad", silhouette_angle_rad, ">= 0");
+  RequireOption(outline_splat_share > 0 && outline_splat_share <= 1, "ForwardWarpOptions.outline_splat_share",
+                outline_splat_share, "(0, 1]");
 }
 
 void WarpBuffer::Reset(int width, int height) {

@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "reproject/simd.h"
+#include "core/check.h"
 
 namespace parallax {
 namespace {
@@ -238,22 +239,13 @@ void MarkCracks(const std::vector<uint8_t>& hole, int width, int height, int rad
 }  // namespace
 
 void HoleOptions::Check() const {
-  if (crack_opening_px < 1 || crack_opening_px % 2 == 0) {
-    throw std::invalid_argument("HoleOptions.crack_opening_px = " +
-                                std::to_string(crack_opening_px) + ": expected odd and >= 1");
-  }
-  if (depth_range_rows < 0) {
-    throw std::invalid_argument("HoleOptions.depth_range_rows = " +
-                                std::to_string(depth_range_rows) + ": expected >= 0");
-  }
-  if (free_space_samples < 2 || free_space_samples > 1024) {
-    throw std::invalid_argument("HoleOptions.free_space_samples = " +
-                                std::to_string(free_space_samples) + ": expected [2, 1024]");
-  }
-  if (!(free_space_tolerance > 0 && free_space_tolerance < 1)) {
-    throw std::invalid_argument("HoleOptions.free_space_tolerance = " +
-                                std::to_string(free_space_tolerance) + ": expected (0, 1)");
-  }
+  RequireOption(crack_opening_px >= 1 && crack_opening_px % 2 == 1, "HoleOptions.crack_opening_px",
+                crack_opening_px, "odd and >= 1");
+  RequireOption(depth_range_rows >= 0, "HoleOptions.depth_range_rows", depth_range_rows, ">= 0");
+  RequireOption(free_space_samples >= 2 && free_space_samples <= 1024, "HoleOptions.free_space_samples",
+                free_space_samples, "[2, 1024]");
+  RequireOption(free_space_tolerance > 0 && free_space_tolerance < 1, "HoleOptions.free_space_tolerance",
+                free_space_tolerance, "(0, 1)");
 }
 
 ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>& sources,
@@ -263,19 +255,14 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
   return ClassifyPixels(blend, frustums, target, options);
 }
 
-ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,
-                        const PosedCamera& target, const HoleOptions& options) {
-  options.Check();
-  const Pinhole pinhole = Pinhole::From(target.camera);
-  const int width = pinhole.width, height = pinhole.height;
-  if (blend.color.Width() != width || blend.color.Height() != height) {
-    throw std::invalid_argument("ClassifyPixels: blend " + std::to_string(blend.color.Width()) +
-                                "x" + std::to_string(blend.color.Height()) +
-                                " does not match the target camera " + std::to_string(width) +
-                                "x" + std::to_string(height));
-  }
+namespace {
+
+// Each source's frustum in the target's frame. `*all_depth`: every source has a depth map.
+// Throws std::invalid_argument for a depth map or mask that does not match its camera.
+std::vector<SourceFrustum> MakeFrustums(const std::vector<ClassifySource>& sources,
+                                        const PosedCamera& target, bool* all_depth) {
   std::vector<SourceFrustum> frustums;
-  bool all_depth = !sources.empty();
+  *all_depth = !sources.empty();
   for (size_t j = 0; j < sources.size(); ++j) {
     const ClassifySource& source = sources[j];
     const Rigid3d source_from_target =
@@ -296,9 +283,27 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
     if (source.background != nullptr && !source.background->empty()) {
       frustum.background = source.background->data();
     }
-    all_depth = all_depth && source.depth != nullptr;
+    *all_depth = *all_depth && source.depth != nullptr;
     frustums.push_back(frustum);
   }
+  return frustums;
+}
+
+}  // namespace
+
+ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,
+                        const PosedCamera& target, const HoleOptions& options) {
+  options.Check();
+  const Pinhole pinhole = Pinhole::From(target.camera);
+  const int width = pinhole.width, height = pinhole.height;
+  if (blend.color.Width() != width || blend.color.Height() != height) {
+    throw std::invalid_argument("ClassifyPixels: blend " + std::to_string(blend.color.Width()) +
+                                "x" + std::to_string(blend.color.Height()) +
+                                " does not match the target camera " + std::to_string(width) +
+                                "x" + std::to_string(height));
+  }
+  bool all_depth = false;
+  const std::vector<SourceFrustum> frustums = MakeFrustums(sources, target, &all_depth);
   const std::vector<DepthRange> rows = RowDepthRanges(blend);
   DepthRange global;
   for (const DepthRange& row : rows) global.Merge(row);

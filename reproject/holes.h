@@ -1,5 +1,5 @@
 #pragma once
-// Classification of every target pixel after blending, and the hole metrics of DESIGN.md.
+// Classification of every target pixel after blending, and the hole metrics of docs/design.md.
 #include <array>
 #include <cstddef>
 #include <cstdint>

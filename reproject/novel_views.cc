@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+#include "core/workspace.h"
 #include "reproject/forward_warp.h"
 #include "reproject/scene_views.h"
 
@@ -96,11 +97,12 @@ std::vector<NamedCamera> Orbit(int frames, const std::vector<PosedCamera>& sourc
 }  // namespace
 
 ViewSetPaths SourcePathsFor(const fs::path& root) {
-  if (fs::is_directory(root / "sparse") && fs::is_directory(root / "images")) {
+  const Workspace workspace(root);
+  if (fs::is_directory(workspace.Sparse()) && fs::is_directory(workspace.Images())) {
     ViewSetPaths paths;
-    paths.images = root / "images";
-    paths.sparse = root / "sparse";
-    paths.depth = root / "depth";
+    paths.images = workspace.Images();
+    paths.sparse = workspace.Sparse();
+    paths.depth = workspace.DepthDir();
     return paths;
   }
   const SceneFolder scene{root};

@@ -48,7 +48,7 @@ class SourceLibrary {
   const SourceView& Load(int index, const ForwardWarpOptions& warp);
   int LoadedCount() const;
   // Runs on each view as it is loaded, before it is warped, to prepare its depth map (for a
-  // workspace's estimated depth: specks out, holes from the mesh; see apps/render_options.h);
+  // workspace's estimated depth: specks out, holes from the mesh; see reproject/workspace_depth.h);
   // returns how many pixels it gave depth. Call before any Load.
   using DepthPreparation = std::function<int(SourceView* view)>;
   void SetDepthPreparation(DepthPreparation preparation) { preparation_ = std::move(preparation); }

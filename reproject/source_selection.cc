@@ -8,17 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "core/statistics.h"
+#include "core/check.h"
+
 namespace parallax {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(mid), values.end());
-  return values[mid];
-}
 
 Eigen::Vector3d ViewDirection(const Rigid3d& cam_from_world) {
   return cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
@@ -44,8 +40,8 @@ double EstimateSceneDepth(const std::vector<PosedCamera>& sources, const PosedCa
     const double t = (d1.dot(w) - b * d0.dot(w)) / denom;
     if (s > 0 && t > 0 && std::isfinite(s)) depths.push_back(s);
   }
-  if (!depths.empty()) return Median(depths);
-  return distances.empty() ? 1.0 : Median(distances);
+  if (!depths.empty()) return UpperMedian(depths);
+  return distances.empty() ? 1.0 : UpperMedian(distances);
 }
 
 // The angle (degrees) at point `p` between the rays to it from a source's centre and from
@@ -134,20 +130,17 @@ std::vector<SourceScore> ScoreAll(const std::vector<PosedCamera>& sources,
 }  // namespace
 
 void SourceSelectionOptions::Check() const {
-  const auto fail = [](const std::string& field, double value, const std::string& expected) {
-    throw std::invalid_argument("SourceSelectionOptions." + field + " = " +
-                                std::to_string(value) + ": expected " + expected);
-  };
-  if (num_sources < 1) fail("num_sources", num_sources, ">= 1");
-  if (!(scene_depth >= 0 && std::isfinite(scene_depth))) fail("scene_depth", scene_depth, ">= 0");
-  if (grid_cols < 1) fail("grid_cols", grid_cols, ">= 1");
-  if (grid_rows < 1) fail("grid_rows", grid_rows, ">= 1");
-  if (!(min_overlap > 0 && min_overlap <= 1)) fail("min_overlap", min_overlap, "(0, 1]");
-  if (!(angle_scale_deg > 0 && std::isfinite(angle_scale_deg))) fail("angle_scale_deg", angle_scale_deg, "> 0");
-  if (hole_sources < 0) fail("hole_sources", hole_sources, ">= 0");
-  if (!(diversity_angle_deg >= 0 && diversity_angle_deg <= 180)) {
-    fail("diversity_angle_deg", diversity_angle_deg, "[0, 180]");
-  }
+  RequireOption(num_sources >= 1, "SourceSelectionOptions.num_sources", num_sources, ">= 1");
+  RequireOption(scene_depth >= 0 && std::isfinite(scene_depth), "SourceSelectionOptions.scene_depth", scene_depth,
+                ">= 0");
+  RequireOption(grid_cols >= 1, "SourceSelectionOptions.grid_cols", grid_cols, ">= 1");
+  RequireOption(grid_rows >= 1, "SourceSelectionOptions.grid_rows", grid_rows, ">= 1");
+  RequireOption(min_overlap > 0 && min_overlap <= 1, "SourceSelectionOptions.min_overlap", min_overlap, "(0, 1]");
+  RequireOption(angle_scale_deg > 0 && std::isfinite(angle_scale_deg), "SourceSelectionOptions.angle_scale_deg",
+                angle_scale_deg, "> 0");
+  RequireOption(hole_sources >= 0, "SourceSelectionOptions.hole_sources", hole_sources, ">= 0");
+  RequireOption(diversity_angle_deg >= 0 && diversity_angle_deg <= 180,
+                "SourceSelectionOptions.diversity_angle_deg", diversity_angle_deg, "[0, 180]");
 }
 
 std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,

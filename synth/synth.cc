@@ -11,6 +11,7 @@
 #include "core/image.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
+#include "core/check.h"
 #include "synth/ray_tracer.h"
 
 namespace parallax {
@@ -41,7 +42,7 @@ SparseModel GroundTruthModel(const Camera& camera, const std::vector<ViewDesc>& 
 }  // namespace
 
 void SynthOptions::Check() const {
-  if (num_threads < 0) throw std::invalid_argument("SynthOptions.num_threads must be >= 0");
+  RequireOption(num_threads >= 0, "SynthOptions.num_threads", num_threads, ">= 0");
 }
 
 Camera SceneCamera(const SceneDesc& scene) {

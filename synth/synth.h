@@ -1,5 +1,5 @@
 #pragma once
-// `parallax synth`: renders a scene description into a scene folder (DESIGN.md layout):
+// `parallax synth`: renders a scene description into a scene folder (docs/design.md layout):
 // training images with ground-truth cameras and depth, and the same for the novel views.
 #include <filesystem>
 #include <string>

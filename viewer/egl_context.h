@@ -1,6 +1,6 @@
 #pragma once
 // A headless OpenGL context: EGL on Mesa's surfaceless platform, no window and no X server.
-// Rendering goes into framebuffer objects (DESIGN.md, "Headless rendering").
+// Rendering goes into framebuffer objects (docs/design.md, "Headless rendering").
 #include <memory>
 
 namespace parallax {

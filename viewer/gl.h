@@ -1,6 +1,6 @@
 #pragma once
 // OpenGL 3.3 core without a loader: Mesa's libOpenGL exports every entry point, so the
-// prototypes of <GL/glcorearb.h> link directly (DESIGN.md, "Headless rendering"). Small RAII
+// prototypes of <GL/glcorearb.h> link directly (docs/design.md, "Headless rendering"). Small RAII
 // owners for GL objects and a shader program with uniform setters.
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>

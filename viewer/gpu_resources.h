@@ -5,9 +5,9 @@
 #include <optional>
 #include <vector>
 
-#include "pipeline/textured_mesh.h"
+#include "geometry/textured_mesh.h"
 #include "viewer/gl.h"
-#include "viewer/ground_plane.h"
+#include "geometry/ground_plane.h"
 
 namespace parallax::gpu {
 

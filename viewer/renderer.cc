@@ -13,6 +13,7 @@
 #include "viewer/gpu_resources.h"
 #include "viewer/shaders.h"
 #include "viewer/view_math.h"
+#include "core/check.h"
 
 namespace parallax {
 namespace {
@@ -159,18 +160,18 @@ std::vector<Vertex> GridLines(const ViewerScene& scene) {
 }  // namespace
 
 void FrameSettings::Check() const {
-  const auto fail = [](const std::string& field, const std::string& value) {
-    throw std::invalid_argument("FrameSettings::" + field + " is out of range: " + value);
-  };
-  if (shadow_map_size < 64 || shadow_map_size > 8192) fail("shadow_map_size (64..8192)", std::to_string(shadow_map_size));
-  if (pcf_radius < 0 || pcf_radius > 4) fail("pcf_radius (0..4)", std::to_string(pcf_radius));
-  if (projective_views < 1 || projective_views > kMaxProjectors) fail("projective_views (1..3)", std::to_string(projective_views));
-  if (!(point_size_px > 0)) fail("point_size_px (> 0)", std::to_string(point_size_px));
-  if (!std::isfinite(exposure_stops)) fail("exposure_stops (finite)", std::to_string(exposure_stops));
-  if (light.type == LightKind::kDirectional && !(light.direction.norm() > 0 && light.direction.allFinite())) {
-    fail("light.direction (finite, non-zero)", "");
+  RequireOption(shadow_map_size >= 64 && shadow_map_size <= 8192, "FrameSettings.shadow_map_size", shadow_map_size,
+                "[64, 8192]");
+  RequireOption(pcf_radius >= 0 && pcf_radius <= 4, "FrameSettings.pcf_radius", pcf_radius, "[0, 4]");
+  RequireOption(projective_views >= 1 && projective_views <= kMaxProjectors, "FrameSettings.projective_views",
+                projective_views, "[1, " + std::to_string(kMaxProjectors) + "]");
+  RequireOption(point_size_px > 0, "FrameSettings.point_size_px", point_size_px, "> 0");
+  RequireOption(std::isfinite(exposure_stops), "FrameSettings.exposure_stops", exposure_stops, "finite");
+  if (light.type == LightKind::kDirectional) {
+    RequireOption(light.direction.norm() > 0 && light.direction.allFinite(), "FrameSettings.light.direction (norm)",
+                  light.direction.norm(), "finite and non-zero");
   }
-  if (!light.position.allFinite()) fail("light.position (finite)", "");
+  RequireOption(light.position.allFinite(), "FrameSettings.light.position (norm)", light.position.norm(), "finite");
 }
 
 const TexturedMesh& DisplayedMesh(const ViewerScene& scene, int width, int height) {
@@ -291,6 +292,13 @@ struct SceneRenderer::Impl {
                     const Eigen::Matrix4f& clip_from_world, int shadow_mode, int projectors);
   void DrawPlanarShadows(const ViewCamera& view, const FrameSettings& settings,
                          const Eigen::Matrix4f& clip_from_world, int projectors);
+  // Re-renders the shadow map when the light, its size or the mesh changed; returns the
+  // surface shader's shadow mode (0 none, 2 map, 3 PCF).
+  int UpdateShadowMap(const FrameSettings& settings);
+  // Binds the eye target at `width` x `height` and clears it to the background (depth cleared
+  // for reverse_z_now).
+  void BeginFrame(int width, int height, const FrameSettings& settings);
+  Eigen::Matrix4f EyeProjection(const ViewCamera& view) const;
 };
 
 void SceneRenderer::Impl::RenderDepthMap(DepthTarget& target, const Eigen::Matrix4f& clip_from_world,
@@ -499,6 +507,61 @@ bool SceneRenderer::UsesReverseZ() const { return impl_->reverse_z; }
 
 std::vector<std::string> SceneRenderer::TakeNotes() { return std::exchange(impl_->notes, {}); }
 
+int SceneRenderer::Impl::UpdateShadowMap(const FrameSettings& settings) {
+  int shadow_mode_uniform = 0;
+  if (settings.shadows == ShadowMode::kMap || settings.shadows == ShadowMode::kPcf) {
+    const Eigen::Matrix4f light_matrix = LightMatrix(settings.light);
+    // PCF taps up to r texels away compare against the centre's depth: more slope bias.
+    const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + static_cast<float>(settings.pcf_radius) : 1.5f;
+    const ShadowMapKey key{light_matrix, settings.shadow_map_size, slope_bias, mesh};
+    if (shadow_key != key) {
+      shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
+      RenderDepthMap(shadow, light_matrix, settings, slope_bias);
+      shadow_key = key;
+    }
+    shadow_from_world = light_matrix;
+    shadow_mode_uniform = settings.shadows == ShadowMode::kMap ? 2 : 3;
+  }
+  return shadow_mode_uniform;
+}
+
+void SceneRenderer::Impl::BeginFrame(int width, int height, const FrameSettings& settings) {
+  eye.Resize(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
+  glViewport(0, 0, width, height);
+  const Eigen::Vector3f background(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
+                                   LinearToSrgb(settings.background.z()));
+  const float clear_colour[4] = {background.x(), background.y(), background.z(), 1};
+  const float clear_aux[4] = {1, 0, 0, 0};
+  glClearBufferfv(GL_COLOR, 0, clear_colour);
+  // The auxiliary target is read back by Render alone: a frame for the window (or a timing)
+  // leaves it out, which saves llvmpipe 16 bytes a pixel written, about 13% of a frame.
+  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
+  glDrawBuffers(2, draw_buffers);
+  if (with_aux) glClearBufferfv(GL_COLOR, 1, clear_aux);
+  glClearDepth(reverse_z_now ? 0.0 : 1.0);
+  glClearStencil(0);
+  glDepthMask(GL_TRUE);
+  glStencilMask(0xff);
+  glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(reverse_z_now ? GL_GREATER : GL_LESS);
+}
+
+Eigen::Matrix4f SceneRenderer::Impl::EyeProjection(const ViewCamera& view) const {
+  Eigen::Matrix4f projection;
+  if (reverse_z_now) {
+    const double near = view.near > 0 ? view.near : DepthBounds(scene.bounds, view.cam_from_world)[0];
+    projection = ReverseZProjection(view.camera, near);
+  } else {
+    // Without reverse-Z the depth range is fitted to what can be seen: the scene's bounds.
+    Eigen::Vector2d range = DepthBounds(scene.bounds, view.cam_from_world);
+    if (view.near > 0) range[0] = view.near;
+    projection = PerspectiveProjection(view.camera, range[0], std::max(range[1], 4 * range[0]), Range());
+  }
+  return projection;
+}
+
 void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer) {
   settings.Check();
   Impl& r = *impl_;
@@ -508,20 +571,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   r.mesh = &DisplayedMesh(r.scene, width, height) == &r.scene.display_mesh ? &r.display_mesh : &r.full_mesh;
 
   // 1. Shadow map from the light.
-  int shadow_mode_uniform = 0;
-  if (settings.shadows == ShadowMode::kMap || settings.shadows == ShadowMode::kPcf) {
-    const Eigen::Matrix4f light_matrix = r.LightMatrix(settings.light);
-    // PCF taps up to r texels away compare against the centre's depth: more slope bias.
-    const float slope_bias = settings.shadows == ShadowMode::kPcf ? 1.5f + static_cast<float>(settings.pcf_radius) : 1.5f;
-    const ShadowMapKey key{light_matrix, settings.shadow_map_size, slope_bias, r.mesh};
-    if (r.shadow_key != key) {
-      r.shadow.Resize(settings.shadow_map_size, settings.shadow_map_size);
-      r.RenderDepthMap(r.shadow, light_matrix, settings, slope_bias);
-      r.shadow_key = key;
-    }
-    r.shadow_from_world = light_matrix;
-    shadow_mode_uniform = settings.shadows == ShadowMode::kMap ? 2 : 3;
-  }
+  const int shadow_mode_uniform = r.UpdateShadowMap(settings);
   glActiveTexture(GL_TEXTURE0 + kShadowUnit);
   glBindTexture(GL_TEXTURE_2D, r.shadow.texture.Get());
   glActiveTexture(GL_TEXTURE0 + kAtlasUnit);
@@ -532,37 +582,8 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   if (settings.texture == TextureMode::kProjective) projectors = r.SetUpProjectors(view, settings);
 
   // 3. The frame.
-  r.eye.Resize(width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, r.eye.framebuffer.Get());
-  glViewport(0, 0, width, height);
-  const Eigen::Vector3f background(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
-                                   LinearToSrgb(settings.background.z()));
-  const float clear_colour[4] = {background.x(), background.y(), background.z(), 1};
-  const float clear_aux[4] = {1, 0, 0, 0};
-  glClearBufferfv(GL_COLOR, 0, clear_colour);
-  // The auxiliary target is read back by Render alone: a frame for the window (or a timing)
-  // leaves it out, which saves llvmpipe 16 bytes a pixel written, about 13% of a frame.
-  const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, r.with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
-  glDrawBuffers(2, draw_buffers);
-  if (r.with_aux) glClearBufferfv(GL_COLOR, 1, clear_aux);
-  glClearDepth(reverse_z ? 0.0 : 1.0);
-  glClearStencil(0);
-  glDepthMask(GL_TRUE);
-  glStencilMask(0xff);
-  glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(reverse_z ? GL_GREATER : GL_LESS);
-
-  Eigen::Matrix4f projection;
-  if (reverse_z) {
-    const double near = view.near > 0 ? view.near : DepthBounds(r.scene.bounds, view.cam_from_world)[0];
-    projection = ReverseZProjection(view.camera, near);
-  } else {
-    // Without reverse-Z the depth range is fitted to what can be seen: the scene's bounds.
-    Eigen::Vector2d range = DepthBounds(r.scene.bounds, view.cam_from_world);
-    if (view.near > 0) range[0] = view.near;
-    projection = PerspectiveProjection(view.camera, range[0], std::max(range[1], 4 * range[0]), r.Range());
-  }
+  r.BeginFrame(width, height, settings);
+  const Eigen::Matrix4f projection = r.EyeProjection(view);
   const Eigen::Matrix4f clip_from_world = projection * ViewMatrix(view.cam_from_world);
   if (!reverse_z && r.reverse_z) {
     // glClipControl is global; this frame's projection uses [-1, 1].

@@ -9,6 +9,17 @@
 
 namespace parallax {
 
+std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name) {
+  if (name.empty()) return std::nullopt;
+  SourceViewCamera(scene, name);  // Throws with the known names when there is none.
+  for (size_t i = 0; i < scene.sources.size(); ++i) {
+    if (scene.sources[i].name == name || std::filesystem::path(scene.sources[i].name).stem() == name) {
+      return static_cast<int>(i);
+    }
+  }
+  return std::nullopt;
+}
+
 ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
   for (const ViewerSource& source : scene.sources) {
     if (source.name == name || std::filesystem::path(source.name).stem() == name) {

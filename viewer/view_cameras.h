@@ -15,6 +15,10 @@ namespace parallax {
 // own intrinsics and pose. Throws BadInputError listing a few names when none matches.
 ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name);
 
+// The index in scene.sources of the camera named `name` (image name or stem); nullopt for an
+// empty name. Throws BadInputError, as SourceViewCamera does, when none matches.
+std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name);
+
 // An orbit about the scene: the point looked at, the distance to it and the elevation above
 // the ground (the azimuth is the caller's).
 struct Orbit {

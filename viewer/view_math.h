@@ -11,7 +11,7 @@
 
 #include "core/camera.h"
 #include "core/pose.h"
-#include "viewer/ground_plane.h"
+#include "geometry/ground_plane.h"
 
 namespace parallax {
 

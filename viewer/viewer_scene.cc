@@ -12,8 +12,10 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/scene_folder.h"
 #include "core/sparse_model.h"
-#include "viewer/robust_bounds.h"
+#include "core/workspace.h"
+#include "geometry/robust_bounds.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -238,10 +240,11 @@ ViewerScene LoadViewerScene(const fs::path& workspace) {
     throw BadInputError(workspace.string() + ": not a folder (expected a parallax workspace)");
   }
   ViewerScene scene;
-  const fs::path obj = workspace / "mesh" / "mesh.obj";
-  const fs::path ply = workspace / "fused.ply";
+  const Workspace ws(workspace);
+  const fs::path obj = ws.Mesh();
+  const fs::path ply = ws.Fused();
   if (fs::exists(obj)) scene.mesh = ReadTexturedMesh(obj);
-  const fs::path display = workspace / "mesh_display" / "mesh.obj";
+  const fs::path display = ws.DisplayMesh();
   if (!scene.mesh.triangles.empty() && fs::exists(display)) scene.display_mesh = ReadTexturedMesh(display);
   if (fs::exists(ply)) scene.points = ReadColouredPly(ply);
   if (scene.mesh.triangles.empty() && scene.points.empty()) {
@@ -249,10 +252,11 @@ ViewerScene LoadViewerScene(const fs::path& workspace) {
                         ": nothing to show: no mesh/mesh.obj and no fused.ply in this folder "
                         "(run 'parallax reconstruct' first)");
   }
-  if (DetectSparseFormat(workspace / "sparse")) {
-    scene.sources = ReadSources(workspace / "sparse", workspace / "images");
-  } else if (DetectSparseFormat(workspace / "gt" / "sparse")) {
-    scene.sources = ReadSources(workspace / "gt" / "sparse", workspace / "images");
+  const SceneFolder scene_folder{workspace};
+  if (DetectSparseFormat(ws.Sparse())) {
+    scene.sources = ReadSources(ws.Sparse(), ws.Images());
+  } else if (DetectSparseFormat(scene_folder.Training().sparse)) {
+    scene.sources = ReadSources(scene_folder.Training().sparse, scene_folder.Training().images);
   }
   FinishViewerScene(scene);
   return scene;

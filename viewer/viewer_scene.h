@@ -13,8 +13,8 @@
 
 #include "core/camera.h"
 #include "core/pose.h"
-#include "pipeline/textured_mesh.h"
-#include "viewer/ground_plane.h"
+#include "geometry/textured_mesh.h"
+#include "geometry/ground_plane.h"
 
 namespace parallax {
 

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "core/check.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 
@@ -180,13 +181,9 @@ struct GlfwWindow {
 }  // namespace
 
 void WindowOptions::Check() const {
-  if (width < 16 || height < 16) {
-    throw std::invalid_argument("WindowOptions::width/height must be >= 16, got " + std::to_string(width) + "x" +
-                                std::to_string(height));
-  }
-  if (!(fov_deg > 1 && fov_deg < 170)) {
-    throw std::invalid_argument("WindowOptions::fov_deg must be in (1, 170), got " + std::to_string(fov_deg));
-  }
+  RequireOption(width >= 16, "WindowOptions.width", width, ">= 16");
+  RequireOption(height >= 16, "WindowOptions.height", height, ">= 16");
+  RequireOption(fov_deg > 1 && fov_deg < 170, "WindowOptions.fov_deg", fov_deg, "(1, 170)");
 }
 
 std::string ViewerKeyHelp() {

@@ -15,6 +15,7 @@
 #include "core/depth_map.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
+#include "core/workspace.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 
@@ -80,8 +81,8 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(20);
   bool mid_depth = false;
   while (std::chrono::steady_clock::now() < deadline) {
-    const size_t maps = CountFiles(workspace / "depth", ".exr");
-    if (maps >= 2 && CountFiles(workspace / "depth", ".json") == 0) {
+    const size_t maps = CountFiles(Workspace(workspace).DepthDir(), ".exr");
+    if (maps >= 2 && CountFiles(Workspace(workspace).DepthDir(), ".json") == 0) {
       mid_depth = true;
       break;
     }
@@ -107,7 +108,7 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   EXPECT_TRUE(skipped.at("mapper"));
   EXPECT_TRUE(skipped.at("undistort"));
   EXPECT_FALSE(skipped.at("depth"));
-  EXPECT_EQ(CountFiles(workspace / "depth", ".exr"), 24u);  // Depth + confidence per view.
+  EXPECT_EQ(CountFiles(Workspace(workspace).DepthDir(), ".exr"), 24u);  // Depth + confidence per view.
   ExpectEveryFileComplete(workspace);
 }
 

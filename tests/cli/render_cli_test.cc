@@ -10,7 +10,8 @@
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
 #include "core/image.h"
-#include "pipeline/textured_mesh.h"
+#include "core/workspace.h"
+#include "geometry/textured_mesh.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 
@@ -77,7 +78,7 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
       "reconstruct " + Quote((kSmall / "images").string()) + " " + Quote(workspace.string()) +
       " --known-cameras " + Quote((kSmall / "gt" / "sparse").string()) + " --no-depth");
   ASSERT_EQ(sfm.exit_code, 0) << sfm.output;
-  ASSERT_FALSE(fs::exists(workspace / "depth"));
+  ASSERT_FALSE(fs::exists(Workspace(workspace).DepthDir()));
   const CliResult render = RunParallax("render " + Quote(workspace.string()) +
                                        " --path between:0003.png,0005.png,2 --sources 2 --out " +
                                        Quote((dir.Path() / "out").string()));
@@ -85,7 +86,7 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_NE(render.output.find("the other views are not needed"), std::string::npos)
       << render.output;
   size_t maps = 0;
-  for (const auto& entry : fs::directory_iterator(workspace / "depth")) {
+  for (const auto& entry : fs::directory_iterator(Workspace(workspace).DepthDir())) {
     maps += entry.path().string().ends_with(".confidence.exr") ? 0 : 1;
   }
   EXPECT_GE(maps, 2u);
@@ -95,11 +96,16 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   std::map<std::string, nlohmann::json> stages = ReportStages(dir.Path() / "out");
   EXPECT_FALSE(stages.at("depth").at("skipped").get<bool>());
   EXPECT_NE(stages.at("depth").at("reason").get<std::string>().find(" of 12 views"), std::string::npos);
+  // The render's depth is a stage of the workspace's graph, cached like reconstruct's.
+  const nlohmann::json cache = nlohmann::json::parse(ReadFileBytes(Workspace(workspace).Stages()));
+  EXPECT_TRUE(cache.contains("depth")) << cache.dump();
+  EXPECT_TRUE(cache.contains("undistort")) << cache.dump();
+  EXPECT_NE(cache.value("depth", ""), cache.value("undistort", "")) << cache.dump();
   EXPECT_TRUE(stages.at("fusion").at("skipped").get<bool>());
   EXPECT_TRUE(stages.at("mesh").at("skipped").get<bool>());
   EXPECT_NE(stages.at("mesh").at("reason").get<std::string>().find("texture atlas"), std::string::npos);
   EXPECT_NE(stages.at("sources").at("reason").get<std::string>().find(" of 12 source views"), std::string::npos);
-  EXPECT_FALSE(fs::exists(workspace / "mesh")) << "the atlas is never made for novel views";
+  EXPECT_FALSE(fs::exists(Workspace(workspace).MeshDir())) << "the atlas is never made for novel views";
   EXPECT_TRUE(stages.at("depth_holes").at("skipped").get<bool>());
   EXPECT_NE(stages.at("depth_holes").at("reason").get<std::string>().find("mesh.obj"), std::string::npos);
 
@@ -110,7 +116,7 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   ground.triangles = {{0, 1, 2}, {0, 2, 3}};
   ground.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};
   ground.atlas = Image(2, 2, 3);
-  WriteTexturedMesh(workspace / "mesh", ground);
+  WriteTexturedMesh(Workspace(workspace).MeshDir(), ground);
   const CliResult with_mesh = RunParallax("render " + Quote(workspace.string()) +
                                           " --path between:0003.png,0005.png,2 --sources 2 --out " +
                                           Quote((dir.Path() / "out_mesh").string()));

@@ -10,18 +10,19 @@
 #include "core/error.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
-#include "pipeline/cloud_evaluation.h"
-#include "pipeline/colmap.h"
-#include "pipeline/fusion.h"
-#include "pipeline/mesh_evaluation.h"
-#include "pipeline/mvs.h"
-#include "pipeline/ply.h"
-#include "pipeline/register_held_out.h"
-#include "pipeline/sgbm.h"
-#include "pipeline/textured_mesh.h"
+#include "core/workspace.h"
+#include "eval/cloud_evaluation.h"
+#include "colmap/runner.h"
+#include "mvs/fusion.h"
+#include "eval/mesh_evaluation.h"
+#include "mvs/mvs.h"
+#include "geometry/ply.h"
+#include "eval/register_held_out.h"
+#include "mvs/sgbm.h"
+#include "geometry/textured_mesh.h"
 #include "tests/cli_runner.h"
-#include "pipeline/depth_evaluation.h"
-#include "pipeline/evaluate.h"
+#include "eval/depth_evaluation.h"
+#include "eval/evaluate.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -40,7 +41,7 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   EXPECT_GT(summary.points3d, 300u);
   EXPECT_LT(summary.mean_reprojection_error_px, 1.0);
   EXPECT_TRUE(summary.plausibility.Plausible());
-  // The workspace layout of DESIGN.md: an undistorted PINHOLE model and its images.
+  // The workspace layout of docs/design.md: an undistorted PINHOLE model and its images.
   const SparseModel model = ReadSparseModel(workspace.Path() / "sparse");
   EXPECT_EQ(model.Cameras().front().model, CameraModel::kPinhole);
   EXPECT_TRUE(std::filesystem::exists(workspace.Path() / "images" / "0000.png"));
@@ -54,7 +55,7 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   EXPECT_LT(evaluation.center_error_rel_mean, 0.02);
   EXPECT_EQ(evaluation.alignment.inliers, 12);
 
-  // Multi-view stereo: the dense files of DESIGN.md, and depth measured in the true cameras.
+  // Multi-view stereo: the dense files of docs/design.md, and depth measured in the true cameras.
   for (const char* file : {"stereo/depth_maps/0005.png.geometric.bin",
                            "stereo/depth_maps/0005.png.photometric.bin",
                            "stereo/normal_maps/0005.png.geometric.bin", "depth/0005.exr",
@@ -63,7 +64,7 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   }
   const SceneFolder scene{kSmall};
   const DepthEvaluation depth = EvaluateDepth(
-      model, workspace.Path() / "depth", ReadSparseModel(scene.Training().sparse),
+      model, Workspace(workspace.Path()).DepthDir(), ReadSparseModel(scene.Training().sparse),
       scene.Training().depth, evaluation.alignment.target_from_source, {});
   EXPECT_EQ(depth.views, 12);
   // Measured 0.61 and 0.69 with SfM cameras (their 0.3 degree error costs accuracy).
@@ -148,7 +149,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // The stereo alone, in the true cameras (measured: within 2% 0.82, completeness 0.88).
   const SceneFolder scene{kSmall};
   const DepthEvaluation depth =
-      EvaluateDepth(model, workspace.Path() / "depth", truth, scene.Training().depth, {}, {});
+      EvaluateDepth(model, Workspace(workspace.Path()).DepthDir(), truth, scene.Training().depth, {}, {});
   EXPECT_GT(depth.within_2pct, 0.6);
   EXPECT_GT(depth.completeness, 0.65);
   EXPECT_LT(depth.abs_rel_median, 0.002);
@@ -156,7 +157,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
 
   // Our fusion, and COLMAP's own stereo_fusion run on our dense workspace: COLMAP accepts it,
   // and both clouds lie on the true surfaces.
-  const CloudAccuracy ours = MeasureCloud(ReadPly(workspace.Path() / "fused.ply").vertices, truth,
+  const CloudAccuracy ours = MeasureCloud(ReadPly(Workspace(workspace.Path()).Fused()).vertices, truth,
                                           scene.Training().depth, {});
   EXPECT_GT(ours.points, 50000u);
   EXPECT_LT(ours.median_relative_distance, 0.005);
@@ -174,7 +175,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
 
   // The textured mesh: on the true surfaces, readable by a standard tool, and its renders
   // reproduce the photos.
-  const std::filesystem::path obj = workspace.Path() / "mesh" / "mesh.obj";
+  const std::filesystem::path obj = Workspace(workspace.Path()).Mesh();
   const TexturedMesh mesh = ReadTexturedMesh(obj);
   EXPECT_GT(mesh.triangles.size(), 5000u);
   const CloudAccuracy vertices = MeasureCloud(mesh.vertices, truth, scene.Training().depth, {});
@@ -204,7 +205,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
     EXPECT_NE(skipped.find("no source view to its right"), std::string::npos) << skipped;
   }
   const DepthEvaluation sgbm =
-      EvaluateDepth(model, workspace.Path() / "depth", truth, scene.Training().depth, {}, {});
+      EvaluateDepth(model, Workspace(workspace.Path()).DepthDir(), truth, scene.Training().depth, {}, {});
   EXPECT_GT(sgbm.completeness, 0.3);
   EXPECT_LT(sgbm.abs_rel_median, 0.01);
   EXPECT_LT(sgbm.within_2pct, depth.within_2pct);
@@ -213,10 +214,10 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   MvsOptions half = MvsOptionsFor(Quality::kBalanced);
   half.image_scale = 0.5;
   RunMultiViewStereo(workspace.Path(), half, progress);
-  EXPECT_EQ(ReadDepthExr(workspace.Path() / "depth" / "0000.exr").Width(),
+  EXPECT_EQ(ReadDepthExr(Workspace(workspace.Path()).Depth("0000.png")).Width(),
             static_cast<int>(truth.Cameras().front().width));
   const DepthEvaluation coarse =
-      EvaluateDepth(model, workspace.Path() / "depth", truth, scene.Training().depth, {}, {});
+      EvaluateDepth(model, Workspace(workspace.Path()).DepthDir(), truth, scene.Training().depth, {}, {});
   std::printf("[ measure ] depth at half resolution: within 2%% %.3f (full %.3f), completeness %.3f\n",
               coarse.within_2pct, depth.within_2pct, coarse.completeness);
   EXPECT_GT(coarse.within_2pct, 0.5);  // 0.725 measured.

@@ -9,7 +9,7 @@
 #include "core/image.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
-#include "reproject/novel_evaluation.h"
+#include "eval/novel_evaluation.h"
 #include "reproject/render.h"
 #include "reproject/scene_views.h"
 #include "reproject/source_selection.h"

@@ -15,7 +15,7 @@
 
 #include "tests/random_rotation.h"
 
-#include "pipeline/similarity.h"
+#include "geometry/similarity.h"
 
 namespace parallax {
 namespace {

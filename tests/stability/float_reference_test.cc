@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/patch_match.h"
+#include "mvs/patch_match.h"
 #include "reproject/forward_warp.h"
 #include "viewer/view_math.h"
 

@@ -1,7 +1,7 @@
 // Structure from motion on a stiff capture (issue: numerical stability): cameras that translate
 // by a tiny baseline without rotating, looking at depths from 1 m to 1 km. COLMAP registers
 // such a capture at about 0.1 px reprojection error with whatever focal length it drifted to
-// (DESIGN.md, measured pitfalls), which the images do not determine. parallax must flag it
+// (docs/design.md, measured pitfalls), which the images do not determine. parallax must flag it
 // instead of passing wrong cameras on.
 #include <cmath>
 #include <cstdio>
@@ -19,7 +19,7 @@
 #include "core/progress.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
-#include "pipeline/plausibility.h"
+#include "sfm/plausibility.h"
 #include "pipeline/reconstruct.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"

@@ -18,9 +18,10 @@
 #include "core/image.h"
 #include "core/progress.h"
 #include "core/sparse_model.h"
-#include "pipeline/depth_filter.h"
-#include "pipeline/patch_match.h"
-#include "pipeline/sgbm.h"
+#include "core/workspace.h"
+#include "mvs/depth_filter.h"
+#include "mvs/patch_match.h"
+#include "mvs/sgbm.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -335,9 +336,10 @@ void WriteStereoWorkspace(const std::filesystem::path& workspace, double depth,
     }
   }
   for (SparseImage& image : images) model.AddImage(image);
-  WriteSparseModel(model, workspace / "sparse", SparseFormat::kBinary);
-  std::filesystem::create_directories(workspace / "images");
-  std::filesystem::create_directories(workspace / "depth");
+  const Workspace layout(workspace);
+  WriteSparseModel(model, layout.Sparse(), SparseFormat::kBinary);
+  std::filesystem::create_directories(layout.Images());
+  std::filesystem::create_directories(layout.DepthDir());
   for (const auto& [name, gray] : {std::pair{"ref.png", &left}, std::pair{"right.png", &right}}) {
     Image photo(gray->width, gray->height, 3);
     for (int y = 0; y < gray->height; ++y) {
@@ -345,7 +347,7 @@ void WriteStereoWorkspace(const std::filesystem::path& workspace, double depth,
         for (int c = 0; c < 3; ++c) photo.At(x, y, c) = gray->At(x, y);
       }
     }
-    WriteImage(workspace / "images" / name, photo, PixelFormat::kUint8);
+    WriteImage(layout.Image(name), photo, PixelFormat::kUint8);
   }
 }
 
@@ -360,7 +362,7 @@ DepthMap RunSgbm(const GrayImage& left, const GrayImage& right, double depth) {
   if (summary.views.empty()) return DepthMap(kWidth, kHeight);
   EXPECT_EQ(summary.views[0].name, "ref.png");
   EXPECT_TRUE(std::isfinite(summary.views[0].geometric_share));
-  return ReadDepthExr(workspace.Path() / "depth" / "ref.exr");
+  return ReadDepthExr(Workspace(workspace.Path()).Depth("ref.png"));
 }
 
 TEST(StereoStability, SgbmFindsATexturedPlane) {

@@ -10,7 +10,7 @@
 #include "core/sparse_model.h"
 #include "tests/temp_dir.h"
 #include "tests/viewer/viewer_test_util.h"
-#include "viewer/robust_bounds.h"
+#include "geometry/robust_bounds.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 

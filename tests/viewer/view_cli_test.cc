@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "core/image.h"
+#include "core/workspace.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 #include "tests/viewer/viewer_test_util.h"
@@ -17,7 +18,7 @@ const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "smal
 void MakeWorkspace(const fs::path& ws) {
   const SceneDesc desc = ReadSceneJson(kSmall / "scene.json");
   const ViewerScene scene = viewer_test::SceneFromObjects(desc.objects);
-  WriteTexturedMesh(ws / "mesh", scene.mesh);
+  WriteTexturedMesh(Workspace(ws).MeshDir(), scene.mesh);
   fs::copy(kSmall / "gt" / "sparse", ws / "sparse", fs::copy_options::recursive);
   fs::copy(kSmall / "images", ws / "images", fs::copy_options::recursive);
 }

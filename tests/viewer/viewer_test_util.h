@@ -8,12 +8,12 @@
 
 #include <Eigen/Geometry>
 
-#include "pipeline/raycaster.h"
+#include "geometry/raycaster.h"
 #include "synth/ray_tracer.h"
 #include "synth/scene.h"
 #include "viewer/egl_context.h"
 #include "viewer/renderer.h"
-#include "viewer/shadow_reference.h"
+#include "eval/shadow_reference.h"
 #include "viewer/viewer_scene.h"
 
 namespace parallax::viewer_test {

@@ -1,0 +1,319 @@
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench/bench_runner.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/scene_folder.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "colmap/subprocess.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+struct ChildRun {
+  double wall_s = 0;
+  double peak_mb = 0;
+  std::string output;
+};
+
+class Bench {
+ public:
+  Bench(fs::path scene, fs::path out) : scene_{std::move(scene)}, out_(std::move(out)) {
+    self_ = fs::read_symlink("/proc/self/exe").string();
+    fs::create_directories(out_ / "logs");
+  }
+
+  // Runs one child to completion, its output in logs/<log>.log. Throws ToolError when it fails.
+  ChildRun Run(const std::string& log, const std::vector<std::string>& argv) {
+    std::fprintf(stderr, "bench: %s ...", log.c_str());
+    std::fflush(stderr);
+    ChildRun run;
+    std::ofstream log_file(out_ / "logs" / (log + ".log"));
+    const auto start = std::chrono::steady_clock::now();
+    const ProcessResult result = RunProcess(argv, {}, [&](std::string_view line) {
+      log_file << line << "\n";
+      run.output.append(line).append("\n");
+    });
+    run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    run.peak_mb = static_cast<double>(result.peak_memory_kb) / 1024.0;
+    std::fprintf(stderr, " %.1f s\n", run.wall_s);
+    if (result.exit_code != 0) {
+      throw ToolError("bench: " + argv[0] + " " + (argv.size() > 1 ? argv[1] : "") +
+                      " failed with exit status " + std::to_string(result.exit_code) + "; see " +
+                      (out_ / "logs" / (log + ".log")).string());
+    }
+    return run;
+  }
+
+  ChildRun Parallax(const std::string& log, std::vector<std::string> arguments) {
+    arguments.insert(arguments.begin(), self_);
+    return Run(log, arguments);
+  }
+
+  // `parallax evaluate` of a workspace; its JSON, and in `run` (when given) the child's cost.
+  nlohmann::json Evaluate(const std::string& log, const fs::path& workspace,
+                          std::vector<std::string> flags, ChildRun* run = nullptr) {
+    const fs::path json = out_ / "logs" / (log + ".json");
+    std::vector<std::string> arguments = {"evaluate", workspace.string(), "--gt",
+                                          scene_.root.string(), "--json", json.string()};
+    arguments.insert(arguments.end(), flags.begin(), flags.end());
+    const ChildRun child = Parallax(log, arguments);
+    if (run != nullptr) *run = child;
+    return nlohmann::json::parse(ReadFileBytes(json));
+  }
+
+  void StructureFromMotion();
+  void Depth();
+  void Render();
+  void Shadows();
+  void LeaveOut();
+
+  const fs::path& Out() const { return out_; }
+  std::vector<BenchRow> rows;
+  std::vector<std::string> leave_out;
+
+ private:
+  fs::path Images() const { return scene_.Training().images; }
+  fs::path KnownWorkspace() const { return out_ / "depth_base"; }
+
+  SceneFolder scene_;
+  fs::path out_;
+  std::string self_;
+};
+
+double At(const nlohmann::json& json, const std::string& section, const std::string& key,
+          const std::string& sub = "") {
+  const nlohmann::json& value = json.at(section).at(key);
+  return sub.empty() ? value.get<double>() : value.at(sub).get<double>();
+}
+
+void Bench::StructureFromMotion() {
+  for (const std::string quality : {"fast", "balanced"}) {
+    const fs::path workspace = out_ / ("sfm_" + quality);
+    fs::remove_all(workspace);
+    const ChildRun run = Parallax("sfm_" + quality, {"reconstruct", Images().string(), workspace.string(),
+                                                     "--quality", quality, "--no-depth"});
+    const nlohmann::json json = Evaluate("sfm_" + quality + "_eval", workspace, {});
+    rows.push_back({"sfm", "parallax", "quality=" + quality,
+                    {{"rotation_error_deg", At(json, "poses", "rotation_error_deg", "mean")},
+                     {"center_error_rel", At(json, "poses", "center_error_rel", "mean")}},
+                    run.wall_s, run.wall_s, run.peak_mb, false});
+  }
+  // COLMAP's own one-command pipeline, sparse only, on the CPU.
+  const fs::path colmap_dir = out_ / "colmap_auto";
+  fs::remove_all(colmap_dir);
+  fs::create_directories(colmap_dir);
+  const ChildRun run = Run("colmap_automatic_reconstructor",
+                           {"colmap", "automatic_reconstructor", "--workspace_path", colmap_dir.string(),
+                            "--image_path", Images().string(), "--dense", "0", "--use_gpu", "0"});
+  const fs::path workspace = out_ / "colmap_auto_ws";
+  fs::remove_all(workspace);
+  fs::create_directories(workspace);
+  fs::copy(colmap_dir / "sparse" / "0", Workspace(workspace).Sparse(), fs::copy_options::recursive);
+  const nlohmann::json json = Evaluate("colmap_auto_eval", workspace, {});
+  rows.push_back({"sfm", "colmap", "automatic_reconstructor --dense 0",
+                  {{"rotation_error_deg", At(json, "poses", "rotation_error_deg", "mean")},
+                   {"center_error_rel", At(json, "poses", "center_error_rel", "mean")}},
+                  run.wall_s, run.wall_s, run.peak_mb, true});
+}
+
+void Bench::Depth() {
+  // Triangulation with the true cameras once; every setting starts from a copy, so only the
+  // depth stage (and fusion) runs: the stereo is measured apart from SfM.
+  const fs::path base = KnownWorkspace();
+  const std::string known = scene_.Training().sparse.string();
+  fs::remove_all(base);
+  Parallax("depth_base", {"reconstruct", Images().string(), base.string(), "--known-cameras", known,
+                          "--no-depth"});
+  struct Setting {
+    std::string id, method, label;
+    std::vector<std::string> flags;
+    bool baseline = false;
+  };
+  const std::vector<Setting> settings = {
+      {"fast", "patchmatch", "quality=fast sources=3", {"--quality", "fast"}},
+      {"balanced", "patchmatch", "quality=balanced sources=5", {"--quality", "balanced"}},
+      {"best", "patchmatch", "quality=best sources=7", {"--quality", "best"}},
+      {"balanced3", "patchmatch", "quality=balanced sources=3", {"--mvs-sources", "3"}},
+      {"balanced7", "patchmatch", "quality=balanced sources=7", {"--mvs-sources", "7"}},
+      {"balanced_half", "patchmatch", "quality=balanced sources=5 scale=0.5", {"--mvs-scale", "0.5"}},
+      {"fast_half", "patchmatch", "quality=fast sources=3 scale=0.5", {"--quality", "fast", "--mvs-scale", "0.5"}},
+      {"sgbm", "sgbm", "OpenCV StereoSGBM, rectified pairs", {"--stereo", "sgbm"}, true}};
+  const int views = static_cast<int>(ReadSparseModel(scene_.Training().sparse).Images().size());
+  for (const Setting& setting : settings) {
+    const fs::path workspace = out_ / ("depth_" + setting.id);
+    fs::remove_all(workspace);
+    fs::copy(base, workspace, fs::copy_options::recursive);
+    std::vector<std::string> arguments = {"reconstruct", Images().string(), workspace.string(),
+                                          "--known-cameras", known, "--no-mesh"};
+    arguments.insert(arguments.end(), setting.flags.begin(), setting.flags.end());
+    const ChildRun run = Parallax("depth_" + setting.id, arguments);
+    const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(Workspace(workspace).Report()));
+    const double depth_seconds = report.at("reconstruct").at("timings_s").at("depth").get<double>();
+    const nlohmann::json json = Evaluate("depth_" + setting.id + "_eval", workspace, {"--no-align"});
+    rows.push_back({"depth", setting.method, setting.label,
+                    {{"abs_rel_median", At(json, "depth", "abs_rel_median")},
+                     {"signed_median", At(json, "depth", "signed_median")},
+                     {"within_2pct", At(json, "depth", "within_2pct")},
+                     {"completeness", At(json, "depth", "completeness")},
+                     {"novel_psnr", At(json, "novel", "psnr_mean")},
+                     {"novel_ssim", At(json, "novel", "ssim_mean")}},
+                    depth_seconds / views, run.wall_s, run.peak_mb, setting.baseline});
+  }
+}
+
+void Bench::Render() {
+  struct Setting {
+    std::string warp;
+    int sources;
+    std::string fill;
+    // More sources while holes or surfaces out of view remain (render --hole-sources).
+    int hole_sources = 0;
+    bool baseline = false;
+    std::string texture_filter = "auto";  // render --texture-filter.
+  };
+  std::vector<Setting> settings;
+  for (const std::string warp : {"mesh", "splat"}) {
+    for (int sources : {1, 2, 4, 6}) settings.push_back({warp, sources, "depth-aware"});
+  }
+  settings.push_back({"mesh", 4, "depth-aware", 1});
+  settings.push_back({"mesh", 4, "depth-aware", 2});  // The default.
+  settings.push_back({"mesh", 4, "depth-aware", 2, false, "bicubic"});
+  settings.push_back({"mesh", 4, "none"});
+  settings.push_back({"mesh", 4, "inpaint"});
+  settings.push_back({"naive", 1, "inpaint", 0, true});
+  for (const Setting& setting : settings) {
+    const bool bicubic = setting.texture_filter != "auto";
+    const std::string id = setting.warp + "_k" + std::to_string(setting.sources) + "_h" +
+                           std::to_string(setting.hole_sources) + "_" + setting.fill +
+                           (bicubic ? "_" + setting.texture_filter : "");
+    ChildRun run;
+    const nlohmann::json json = Evaluate(
+        "render_" + id, KnownWorkspace(),
+        {"--gt-sources", "--novel-only", "--sources", std::to_string(setting.sources),
+         "--hole-sources", std::to_string(setting.hole_sources), "--warp", setting.warp,
+         "--fill", setting.fill, "--texture-filter", setting.texture_filter},
+        &run);
+    rows.push_back({"render", setting.baseline ? "naive" : "parallax",
+                    "warp=" + setting.warp + " K=" + std::to_string(setting.sources) +
+                        " hole-sources=" + std::to_string(setting.hole_sources) +
+                        " fill=" + setting.fill +
+                        (bicubic ? " texture-filter=" + setting.texture_filter : ""),
+                    {{"psnr", At(json, "novel", "psnr_mean")},
+                     {"ssim", At(json, "novel", "ssim_mean")},
+                     {"psnr_valid", At(json, "novel", "psnr_valid_mean")},
+                     {"hole_ratio", At(json, "novel", "hole_ratio_mean")}},
+                    At(json, "novel", "ms_per_view"), run.wall_s, run.peak_mb, setting.baseline});
+  }
+}
+
+// The number after `key` in a child's output (the first occurrence); throws when it is missing.
+double NumberAfter(const std::string& output, const std::string& key, const std::string& log) {
+  const size_t at = output.find(key);
+  if (at == std::string::npos) throw ToolError("bench: no '" + key + "' in the output of " + log);
+  return std::stod(output.substr(at + key.size()));
+}
+
+void Bench::Shadows() {
+  // The viewer on the balanced workspace's mesh (only the mesh stage runs: depth and fusion are
+  // done), from the 30 degree orbit at 1280x720; each frame's shadow mask against Embree's for
+  // the mesh it drew. Cast shadows alone rank the settings (see CompareCastShadows).
+  const fs::path workspace = out_ / "depth_balanced";
+  Parallax("shadows_mesh", {"reconstruct", Images().string(), workspace.string(), "--known-cameras",
+                            scene_.Training().sparse.string()});
+  fs::create_directories(out_ / "shadows");
+  for (const int size : {512, 1024, 2048, 4096}) {
+    for (const int radius : {0, 1, 2}) {
+      const std::string mode = radius == 0 ? "map" : "pcf";
+      const std::string id = mode + std::to_string(radius) + "_" + std::to_string(size);
+      const ChildRun run = Parallax(
+          "shadows_" + id, {"view", workspace.string(), "--screenshot", (out_ / "shadows" / (id + ".png")).string(),
+                            "--orbit", "30", "--no-cameras", "--no-grid", "--shadows", mode, "--shadow-map-size",
+                            std::to_string(size), "--pcf-radius", std::to_string(radius), "--shadow-iou",
+                            "--time-frames", "20"});
+      const std::string log = "shadows_" + id;
+      rows.push_back({"shadows", "parallax",
+                      mode + (radius > 0 ? " r=" + std::to_string(radius) : "") + " " + std::to_string(size) + "^2",
+                      {{"iou_cast", NumberAfter(run.output, "cast shadows alone: ", log)},
+                       {"iou", NumberAfter(run.output, "shadow IoU against Embree ray tracing: ", log)},
+                       {"ms_still_light", NumberAfter(run.output, "): median ", log)}},
+                      NumberAfter(run.output, "(shadow map re-rendered): median ", log), run.wall_s, run.peak_mb,
+                      false});
+    }
+  }
+}
+
+void Bench::LeaveOut() {
+  // A second identical run of a finished workspace.
+  const fs::path workspace = out_ / "depth_balanced";
+  double first = 0;
+  for (const BenchRow& row : rows) {
+    if (row.stage == "depth" && row.setting == "quality=balanced sources=5") first = row.wall_s;
+  }
+  const ChildRun again = Parallax("rerun", {"reconstruct", Images().string(), workspace.string(),
+                                           "--known-cameras", scene_.Training().sparse.string(), "--no-mesh"});
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "unchanged inputs: a second identical `reconstruct` (depth balanced) takes %.1f s "
+                "instead of %.1f s (%.0fx faster)",
+                again.wall_s, first, again.wall_s > 0 ? first / again.wall_s : 0.0);
+  leave_out.push_back(line);
+
+  // Rendering from a workspace with only the sparse model: depth only where it is used.
+  const fs::path sparse_only = out_ / "leave_out_ws";
+  fs::remove_all(sparse_only);
+  fs::copy(KnownWorkspace(), sparse_only, fs::copy_options::recursive);
+  const SparseModel model = ReadSparseModel(scene_.Training().sparse);
+  const std::string a = model.Images().front().name, b = model.Images()[1].name;
+  const ChildRun render = Parallax("leave_out_render",
+                                   {"render", sparse_only.string(), "--path", "between:" + a + "," + b + ",3",
+                                    "--out", (out_ / "leave_out_render").string()});
+  for (size_t start = 0, end; (end = render.output.find('\n', start)) != std::string::npos; start = end + 1) {
+    const std::string text = render.output.substr(start, end - start);
+    if (text.rfind("depth: estimated", 0) == 0 || text.rfind("rendered", 0) == 0) {
+      leave_out.push_back("`render --path between:" + a + "," + b + ",3` on a workspace without depth maps: " + text);
+    }
+  }
+  leave_out.push_back("stages skipped, with the reason, are listed per workspace in report.json "
+                      "(e.g. depth_balanced/report.json; `reconstruct --dry-run` prints the plan)");
+}
+
+}  // namespace
+
+BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir) {
+  const SceneFolder scene{scene_dir};
+  if (!fs::is_directory(scene.Training().sparse) || !fs::is_directory(scene.Novel().sparse)) {
+    throw BadInputError(scene_dir.string() + " has no ground truth (gt/sparse, novel/sparse): "
+                        "bench needs a scene folder made by parallax synth");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  Bench bench(scene_dir, out_dir);
+  bench.StructureFromMotion();
+  bench.Depth();
+  bench.Render();
+  bench.Shadows();
+  bench.LeaveOut();
+  const std::vector<BenchStage> stages = {
+      {"sfm", "rotation_error_deg", "rotation error (deg)", false, "s"},
+      {"depth", "within_2pct", "within 2% (share)", true, "s per view"},
+      {"render", "psnr", "PSNR (dB)", true, "ms per view"},
+      {"shadows", "iou_cast", "cast-shadow IoU vs Embree", true, "ms per frame (light moving)"}};
+  BenchSummary summary;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.runs = bench.rows.size();
+  WriteBenchReport(bench.Out(), bench.rows, stages, DescribeMachine(), bench.leave_out, summary.seconds);
+  return summary;
+}
+
+}  // namespace parallax

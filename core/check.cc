@@ -1,0 +1,17 @@
+#include "core/check.h"
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+namespace parallax {
+
+void RequireOption(bool ok, std::string_view field, double value, std::string_view expected) {
+  if (ok) return;
+  char number[32];
+  std::snprintf(number, sizeof(number), "%.9g", value);
+  throw std::invalid_argument(std::string(field) + " = " + number + ": expected " +
+                              std::string(expected));
+}
+
+}  // namespace parallax

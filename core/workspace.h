@@ -1,0 +1,81 @@
+#pragma once
+// The layout of a workspace, the folder `reconstruct` writes and `render`, `evaluate` and
+// `view` read (docs/design.md "Workspace"). Every path inside a workspace comes from here.
+#include <filesystem>
+#include <string>
+
+namespace parallax {
+
+// What a COLMAP dense map was computed from: photometric consistency only, or also the
+// neighbours' geometry.
+enum class StereoPass { kPhotometric, kGeometric };
+
+class Workspace {
+ public:
+  explicit Workspace(std::filesystem::path root) : root_(std::move(root)) {}
+
+  const std::filesystem::path& Root() const { return root_; }
+
+  // The undistorted PINHOLE model and photos, in COLMAP's dense-workspace layout.
+  std::filesystem::path Sparse() const { return root_ / "sparse"; }
+  std::filesystem::path Images() const { return root_ / "images"; }
+  std::filesystem::path Image(const std::string& name) const { return Images() / name; }
+  // COLMAP's dense format: stereo/depth_maps/<photo>.<pass>.bin, stereo/normal_maps/...
+  std::filesystem::path Stereo() const { return root_ / "stereo"; }
+  std::filesystem::path StereoDepthMaps() const { return Stereo() / "depth_maps"; }
+  std::filesystem::path StereoNormalMaps() const { return Stereo() / "normal_maps"; }
+  std::filesystem::path StereoConsistencyGraphs() const { return Stereo() / "consistency_graphs"; }
+  std::filesystem::path StereoDepthMap(const std::string& photo, StereoPass pass) const;
+  std::filesystem::path StereoNormalMap(const std::string& photo, StereoPass pass) const;
+  std::filesystem::path StereoConfig(const std::string& file) const { return Stereo() / file; }
+
+  // Structure from motion's own files: the COLMAP database, the raw (distorted) models.
+  std::filesystem::path Sfm() const { return root_ / "sfm"; }
+  std::filesystem::path Database() const { return Sfm() / "database.db"; }
+  std::filesystem::path ImageList() const { return Sfm() / "image_list.txt"; }
+  std::filesystem::path KnownModel() const { return Sfm() / "known"; }
+  std::filesystem::path Models() const { return Sfm() / "models"; }
+  std::filesystem::path RawModel() const { return Sfm() / "sparse"; }
+  std::filesystem::path MatchedMarker() const { return Sfm() / "matched"; }
+  std::filesystem::path LoopPairs() const { return Sfm() / "loop_pairs.txt"; }
+  std::filesystem::path RefinedModelScratch() const { return Sfm() / "refined.tmp"; }
+
+  // Depth maps at each photo's size: depth/<stem>.exr and depth/<stem>.confidence.exr.
+  std::filesystem::path DepthDir() const { return root_ / "depth"; }
+  std::filesystem::path Depth(const std::string& photo) const;
+  std::filesystem::path DepthConfidence(const std::string& photo) const;
+  std::filesystem::path DepthViews() const { return DepthDir() / "views.json"; }
+
+  std::filesystem::path Fused() const { return root_ / "fused.ply"; }
+  std::filesystem::path PoissonMesh() const { return root_ / "mesh_poisson.ply"; }
+  std::filesystem::path PoissonMeshScratch() const { return root_ / "mesh_poisson.tmp.ply"; }
+  // The textured mesh (mesh.obj, mesh.mtl, mesh.png) and the viewer's simplified copy.
+  std::filesystem::path MeshDir() const { return root_ / "mesh"; }
+  std::filesystem::path Mesh() const { return MeshDir() / "mesh.obj"; }
+  std::filesystem::path MeshSummary() const { return MeshDir() / "summary.json"; }
+  std::filesystem::path DisplayMeshDir() const { return root_ / "mesh_display"; }
+  std::filesystem::path DisplayMesh() const { return DisplayMeshDir() / "mesh.obj"; }
+
+  std::filesystem::path Logs() const { return root_ / "logs"; }
+  std::filesystem::path Log(const std::string& stage) const { return Logs() / (stage + ".log"); }
+  std::filesystem::path Report() const { return root_ / "report.json"; }
+  std::filesystem::path Stages() const { return root_ / "stages.json"; }
+  // Scratch folders of a stage that replaces its outputs whole.
+  std::filesystem::path UndistortScratch() const { return root_ / ".undistort.tmp"; }
+  std::filesystem::path WriteProbe() const { return root_ / ".parallax_write_test"; }
+
+  // What `evaluate` writes.
+  std::filesystem::path EvaluationJson() const { return root_ / "evaluation.json"; }
+  std::filesystem::path EvaluationDir() const { return root_ / "evaluation"; }
+  std::filesystem::path DepthErrorImages() const { return EvaluationDir() / "depth_error"; }
+  std::filesystem::path MeshRenders() const { return EvaluationDir() / "mesh_render"; }
+  std::filesystem::path NovelRegistration() const { return EvaluationDir() / "novel_registration"; }
+  std::filesystem::path NovelComparisons(bool ground_truth_sources) const {
+    return EvaluationDir() / (ground_truth_sources ? "novel_gt_sources" : "novel");
+  }
+
+ private:
+  std::filesystem::path root_;
+};
+
+}  // namespace parallax

@@ -1,0 +1,101 @@
+#include "eval/novel_evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.h"
+#include "core/image.h"
+#include "core/image_metrics.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+Eigen::Vector3f ClassColour(PixelClass pixel_class) {
+  switch (pixel_class) {
+    case PixelClass::kCovered: return {0, 0, 0};
+    case PixelClass::kBackground: return {0.2f, 0.4f, 1};
+    case PixelClass::kOutOfView: return {0.5f, 0.5f, 0.5f};
+    case PixelClass::kCrack: return {1, 0.9f, 0};
+    case PixelClass::kDisocclusion: return {1, 0, 0};
+  }
+  return {1, 1, 1};
+}
+
+// render | truth | |error| x 4 | classes, side by side (sRGB).
+Image SideBySide(const Image& render, const Image& truth, const ClassMap& classes) {
+  const int w = render.Width(), h = render.Height();
+  Image out(4 * w, h, 3);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const Eigen::Vector3f pixel_class = ClassColour(classes.At(x, y));
+      for (int c = 0; c < 3; ++c) {
+        out.At(x, y, c) = render.At(x, y, c);
+        out.At(w + x, y, c) = truth.At(x, y, c);
+        out.At(2 * w + x, y, c) = std::min(1.0f, 4 * std::abs(render.At(x, y, c) - truth.At(x, y, c)));
+        out.At(3 * w + x, y, c) = pixel_class[c];
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<NamedCamera>& targets,
+                                   const std::vector<std::string>& truth_image_names,
+                                   const ViewSetPaths& truth,
+                                   const SourceSelectionOptions& selection,
+                                   const RenderOptions& options, const fs::path& comparison_dir) {
+  NovelEvaluation evaluation;
+  Renderer renderer(options);
+  NovelView view;
+  for (size_t i = 0; i < targets.size(); ++i) {
+    const fs::path truth_path = truth.images / truth_image_names.at(i);
+    const Image truth_image = ReadImage(truth_path);
+    RenderNovelView(library, targets[i], selection, renderer, &view);
+    const Image render = LinearToSrgb(view.result.color);
+    if (truth_image.Width() != render.Width() || truth_image.Height() != render.Height() ||
+        truth_image.Channels() < 3) {
+      throw BadInputError(truth_path.string() + ": not an RGB image of its camera's size");
+    }
+    std::vector<uint8_t> sampled(view.result.classes.classes.size());
+    for (size_t p = 0; p < sampled.size(); ++p) {
+      const PixelClass c = view.result.classes.classes[p];
+      sampled[p] = c == PixelClass::kCovered || c == PixelClass::kBackground;
+    }
+    const HoleMetrics& metrics = view.result.metrics;
+    const NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
+                               Psnr(render, truth_image, sampled), metrics.hole_ratio};
+    evaluation.per_view.push_back(score);
+    evaluation.psnr_mean += score.psnr;
+    evaluation.ssim_mean += score.ssim;
+    evaluation.psnr_valid_mean += score.psnr_valid;
+    evaluation.hole_ratio_mean += metrics.hole_ratio;
+    evaluation.crack_ratio_mean += metrics.crack_ratio;
+    evaluation.out_of_view_ratio_mean += metrics.out_of_view_ratio;
+    evaluation.background_ratio_mean += metrics.background_ratio;
+    evaluation.hole_ratio_filled_mean += view.result.fill.hole_ratio_filled;
+    evaluation.ms_per_view += view.ms;
+    ++evaluation.views;
+    if (!comparison_dir.empty()) {
+      fs::create_directories(comparison_dir);
+      WriteImage(comparison_dir / (targets[i].name + ".png"),
+                 SideBySide(render, truth_image, view.result.classes), PixelFormat::kUint8);
+    }
+  }
+  if (evaluation.views > 0) {
+    const double n = evaluation.views;
+    for (double* mean : {&evaluation.psnr_mean, &evaluation.ssim_mean, &evaluation.psnr_valid_mean,
+                         &evaluation.hole_ratio_mean, &evaluation.crack_ratio_mean,
+                         &evaluation.out_of_view_ratio_mean, &evaluation.background_ratio_mean,
+                         &evaluation.hole_ratio_filled_mean, &evaluation.ms_per_view}) {
+      *mean /= n;
+    }
+  }
+  evaluation.sources_loaded = library.LoadedCount();
+  evaluation.sources_total = static_cast<int>(library.Cameras().size());
+  return evaluation;
+}
+
+}  // namespace parallax

@@ -1,0 +1,49 @@
+#pragma once
+// Novel views against ground truth (docs/design.md evaluate JSON, "novel" section): each held-out
+// camera rendered from the sources and compared with its real image.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/scene_folder.h"
+#include "reproject/novel_views.h"
+
+namespace parallax {
+
+// One novel view's scores (as the means below).
+struct NovelViewScore {
+  std::string name;
+  double psnr = 0;
+  double ssim = 0;
+  double psnr_valid = 0;
+  double hole_ratio = 0;
+};
+
+struct NovelEvaluation {
+  std::vector<NovelViewScore> per_view;  // In the order of the targets.
+  int views = 0;
+  double psnr_mean = 0;        // All pixels, after filling (sRGB in [0, 1]).
+  double ssim_mean = 0;        // All pixels, after filling.
+  double psnr_valid_mean = 0;  // Pixels a sample landed on (surface or background), before filling.
+  double hole_ratio_mean = 0;
+  double crack_ratio_mean = 0;
+  double out_of_view_ratio_mean = 0;
+  double background_ratio_mean = 0;
+  double hole_ratio_filled_mean = 0;
+  double ms_per_view = 0;
+  int sources_loaded = 0;  // Source views read from disk, of `sources_total`.
+  int sources_total = 0;
+};
+
+// Renders every camera of `targets` (in the sources' frame; names are the stems of the
+// ground-truth images in `truth.images`) and compares. With a non-empty `comparison_dir`,
+// writes <name>.png there: render | ground truth | error x4 | pixel classes (covered black,
+// background blue, out of view grey, crack yellow, disocclusion red).
+NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<NamedCamera>& targets,
+                                   const std::vector<std::string>& truth_image_names,
+                                   const ViewSetPaths& truth,
+                                   const SourceSelectionOptions& selection,
+                                   const RenderOptions& options,
+                                   const std::filesystem::path& comparison_dir);
+
+}  // namespace parallax

@@ -1,0 +1,120 @@
+#include "eval/register_held_out.h"
+
+#include <algorithm>
+#include <exception>
+#include <vector>
+
+#include "core/atomic_file.h"
+#include "core/hash.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "colmap/runner.h"
+#include "colmap/database.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+
+namespace {
+
+// Copies the database into `work_dir`, adds the photos' features and their matches with every
+// registered image, and registers them into a copy of `raw_model` at <work_dir>/model.
+// Throws ToolError when colmap fails.
+void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, const SparseModel& model,
+                        const fs::path& images_dir, const std::vector<std::string>& names,
+                        const std::string& list, const std::string& pairs, const fs::path& work_dir,
+                        Progress& progress) {
+  const fs::path registered = work_dir / "model";
+  fs::remove_all(work_dir);
+  fs::create_directories(registered);
+  const fs::path db = work_dir / "database.db";
+  fs::copy_file(database, db);
+  WriteFileAtomically(work_dir / "image_list.txt", list);
+  WriteFileAtomically(work_dir / "pairs.txt", pairs);
+  const Colmap colmap;
+  const fs::path log = work_dir / "colmap.log";
+  const int count = static_cast<int>(names.size());
+  std::vector<std::string> extract = {
+      "--database_path", db.string(), "--image_path", images_dir.string(),
+      "--image_list_path", (work_dir / "image_list.txt").string(),
+      "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "2000",
+      "--SiftExtraction.max_num_features", "4096"};
+  // One shared camera (the usual capture): the held-out photos are taken with it.
+  if (model.Cameras().size() == 1) {
+    extract.insert(extract.end(), {"--ImageReader.existing_camera_id",
+                                   std::to_string(model.Cameras().front().id)});
+  } else {
+    extract.insert(extract.end(), {"--ImageReader.single_camera", "1"});
+  }
+  colmap.Run("feature_extractor", extract, log, "held-out features", count, progress);
+  colmap.Run("matches_importer",
+             {"--database_path", db.string(), "--match_list_path",
+              (work_dir / "pairs.txt").string(), "--match_type", "pairs",
+              "--SiftMatching.use_gpu", "0"},
+             log, "held-out matches", count, progress);
+  colmap.Run("image_registrator",
+             {"--database_path", db.string(), "--input_path", raw_model.string(),
+              "--output_path", registered.string()},
+             log, "held-out registration", count, progress);
+  fs::remove(db);  // A copy of the workspace's, plus a few images: not worth keeping.
+}
+
+}  // namespace
+
+HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::path& images_dir,
+                                          const std::vector<std::string>& names,
+                                          const fs::path& work_dir, Progress& progress) {
+  HeldOutRegistration result;
+  const Workspace ws(workspace);
+  const fs::path database = ws.Database();
+  const fs::path raw_model = ws.RawModel();
+  if (!fs::exists(database) || !DetectSparseFormat(raw_model)) {
+    result.note = "no SfM database and model in " + ws.Sfm().string() +
+                  " (made from known cameras?)";
+    return result;
+  }
+  const SparseModel model = ReadSparseModel(raw_model);
+  // Photos the database holds already (registered or not) would be taken for these.
+  const std::map<std::string, DatabaseImage> in_database = ReadDatabaseImages(database);
+  std::string pairs, list;
+  Hasher key_hasher;
+  key_hasher.Add("held-out-1").Add(static_cast<uint64_t>(fs::file_size(database)));
+  std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
+  std::sort(model_files.begin(), model_files.end());
+  for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
+  for (const std::string& name : names) {
+    if (in_database.contains(name)) {
+      result.note = name + " is also a training photo's name";
+      return result;
+    }
+    for (const SparseImage& image : model.Images()) pairs += name + " " + image.name + "\n";
+    list += name + "\n";
+    key_hasher.Add(name).Add(ReadFileBytes(images_dir / name));
+  }
+  const std::string key = key_hasher.Hex();
+  const fs::path registered = work_dir / "model";
+  const fs::path key_file = work_dir / "key.txt";
+  const bool reuse = fs::exists(key_file) && ReadFileBytes(key_file) == key &&
+                     DetectSparseFormat(registered);
+  if (!reuse) {
+    try {
+      RegisterWithColmap(database, raw_model, model, images_dir, names, list, pairs, work_dir, progress);
+      WriteFileAtomically(key_file, key);
+    } catch (const std::exception& e) {
+      result.note = std::string("colmap could not register them: ") + e.what();
+      return result;
+    }
+  }
+  const SparseModel with_held_out = ReadSparseModel(registered);
+  for (const SparseImage& image : with_held_out.Images()) {
+    if (std::find(names.begin(), names.end(), image.name) != names.end()) {
+      result.cam_from_world[image.name] = image.cam_from_world;
+    }
+  }
+  result.note = std::to_string(result.cam_from_world.size()) + " of " +
+                std::to_string(names.size()) +
+                " registered into the SfM model by colmap image_registrator" +
+                (reuse ? " (reused from " + work_dir.string() + ")" : " (" + work_dir.string() + ")");
+  return result;
+}
+
+}  // namespace parallax

@@ -1,0 +1,181 @@
+#include "eval/workspace_evaluation.h"
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/sparse_model.h"
+#include "eval/register_held_out.h"
+#include "geometry/ply.h"
+#include "geometry/textured_mesh.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+// Whether `dir` holds depth maps `<stem>.exr` (confidence maps `<stem>.confidence.exr` aside).
+bool HasDepthMaps(const fs::path& dir) {
+  std::error_code error;
+  if (!fs::is_directory(dir, error)) return false;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && entry.path().extension() == ".exr" &&
+        !name.ends_with(".confidence.exr")) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// Stage timings recorded by reconstruct, when the workspace has them.
+std::optional<std::map<std::string, double>> ReconstructTimings(const Workspace& workspace) {
+  if (!fs::exists(workspace.Report())) return std::nullopt;
+  try {
+    const nlohmann::json json = nlohmann::json::parse(ReadFileBytes(workspace.Report()));
+    return json.at("reconstruct").at("timings_s").get<std::map<std::string, double>>();
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estimate,
+                            const SparseModel& truth, const SceneFolder& scene,
+                            const Similarity3d& truth_from_estimate) {
+  const TexturedMesh mesh = ReadTexturedMesh(workspace.Mesh());
+  MeshEvaluation result;
+  result.triangles = mesh.triangles.size();
+  result.vertices = mesh.vertices.size();
+  result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
+  result.render_dir = workspace.MeshRenders();
+  result.texture = ScoreTexturedMesh(mesh, estimate, workspace.Images(), result.render_dir);
+  return result;
+}
+
+// The scene's novel cameras rendered from the workspace (cameras mapped into its frame) or,
+// with gt_sources, from the scene's own training views and depth; compared with the novel
+// images.
+NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder& scene,
+                                   const EvaluateOptions& options,
+                                   const Similarity3d& truth_from_estimate, Progress& progress) {
+  NovelViewsEvaluation evaluation;
+  evaluation.gt_sources = options.gt_sources;
+  const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
+  const Similarity3d estimate_from_truth =
+      options.gt_sources ? Similarity3d{} : truth_from_estimate.Inverse();
+  std::vector<NamedCamera> targets;
+  std::vector<std::string> names;
+  for (const SparseImage& image : novel.Images()) {
+    targets.push_back({fs::path(image.name).stem().string(),
+                       {novel.CameraById(image.camera_id),
+                        estimate_from_truth.TransformPose(image.cam_from_world)}});
+    names.push_back(image.name);
+  }
+  evaluation.poses = options.gt_sources ? "ground truth" : "aligned";
+  if (!options.gt_sources && options.novel_poses == NovelPoses::kRegistered) {
+    const HeldOutRegistration registration = RegisterHeldOutPhotos(
+        workspace.Root(), scene.Novel().images, names, workspace.NovelRegistration(), progress);
+    for (size_t i = 0; i < names.size(); ++i) {
+      const auto found = registration.cam_from_world.find(names[i]);
+      if (found == registration.cam_from_world.end()) continue;
+      targets[i].camera.cam_from_world = found->second;
+      ++evaluation.poses_registered;
+    }
+    evaluation.registration_tried = true;
+    evaluation.registration_note = registration.note;
+    if (evaluation.poses_registered < static_cast<int>(names.size())) {
+      evaluation.registration_note += "; the others from the alignment";
+    }
+    if (evaluation.poses_registered > 0) evaluation.poses = "registered";
+  }
+  SourceLibrary library(options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root()));
+  library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
+  if (!options.gt_sources) {
+    evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
+  }
+  evaluation.comparison_dir = workspace.NovelComparisons(options.gt_sources);
+  evaluation.result = EvaluateNovelViews(library, targets, names, scene.Novel(),
+                                         options.novel.selection, options.novel.render,
+                                         evaluation.comparison_dir);
+  return evaluation;
+}
+
+}  // namespace
+
+WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFolder& scene,
+                                      const EvaluateOptions& options, Progress& progress) {
+  if (!DetectSparseFormat(workspace.Sparse())) {
+    throw BadInputError(workspace.Sparse().string() + " holds no COLMAP model: run parallax "
+                        "reconstruct first");
+  }
+  const SparseModel estimate = ReadSparseModel(workspace.Sparse());
+  const SparseModel truth = ReadSparseModel(scene.Training().sparse);
+  WorkspaceEvaluation evaluation;
+  evaluation.poses = EvaluatePoses(estimate, truth);
+  const Similarity3d truth_from_estimate =
+      options.align ? evaluation.poses.alignment.target_from_source : Similarity3d{};
+
+  const bool has_depth = HasDepthMaps(workspace.DepthDir());
+  if (has_depth && !options.novel_only) {
+    evaluation.depth_aligned = options.align;
+    evaluation.depth_error_dir = workspace.DepthErrorImages();
+    DepthEvaluation depth = EvaluateDepth(estimate, workspace.DepthDir(), truth, scene.Training().depth,
+                                          truth_from_estimate, evaluation.depth_error_dir);
+    if (depth.views > 0) {
+      evaluation.depth = std::move(depth);
+    } else {
+      evaluation.depth_without_truth = true;
+    }
+  }
+  if (fs::exists(workspace.Fused()) && !options.novel_only) {
+    evaluation.fused = MeasureCloud(ReadPly(workspace.Fused()).vertices, truth,
+                                    scene.Training().depth, truth_from_estimate);
+  }
+  if (fs::exists(workspace.Mesh()) && !options.novel_only) {
+    evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate);
+  }
+  if (fs::is_directory(scene.Novel().sparse) && (options.gt_sources || has_depth)) {
+    evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate, progress);
+  }
+  evaluation.reconstruct_timings_s = ReconstructTimings(workspace);
+  return evaluation;
+}
+
+void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
+  json = nlohmann::json::object();
+  AddPoseSections(evaluation.poses, json);
+  if (evaluation.depth) AddDepthSection(*evaluation.depth, json);
+  if (evaluation.fused) {
+    const CloudAccuracy& cloud = *evaluation.fused;
+    json["fused"] = {{"points", cloud.points},
+                     {"measured", cloud.measured},
+                     {"median_relative_distance", cloud.median_relative_distance},
+                     {"within_1pct", cloud.within_1pct}};
+  }
+  if (evaluation.mesh) {
+    const MeshEvaluation& mesh = *evaluation.mesh;
+    json["mesh"] = {{"triangles", mesh.triangles},
+                    {"vertices", mesh.vertices},
+                    {"median_relative_distance", mesh.accuracy.median_relative_distance},
+                    {"within_1pct", mesh.accuracy.within_1pct},
+                    {"textured_psnr_mean", mesh.texture.psnr_mean},
+                    {"textured_coverage_mean", mesh.texture.coverage_mean}};
+  }
+  if (evaluation.novel) {
+    const NovelViewsEvaluation& novel = *evaluation.novel;
+    const NovelEvaluation& result = novel.result;
+    json["novel"] = {{"views", result.views},
+                     {"psnr_mean", result.psnr_mean},
+                     {"ssim_mean", result.ssim_mean},
+                     {"psnr_valid_mean", result.psnr_valid_mean},
+                     {"hole_ratio_mean", result.hole_ratio_mean},
+                     {"crack_ratio_mean", result.crack_ratio_mean},
+                     {"out_of_view_ratio_mean", result.out_of_view_ratio_mean},
+                     {"background_ratio_mean", result.background_ratio_mean},
+                     {"hole_ratio_filled_mean", result.hole_ratio_filled_mean},
+                     {"ms_per_view", result.ms_per_view},
+                     {"gt_sources", novel.gt_sources},
+                     {"poses", novel.poses},
+                     {"poses_registered", novel.poses_registered}};
+  }
+  if (evaluation.reconstruct_timings_s) json["timings_s"] = *evaluation.reconstruct_timings_s;
+}
+
+}  // namespace parallax

@@ -1,0 +1,82 @@
+#pragma once
+// `parallax evaluate`: a workspace measured against a scene folder's ground truth, every part
+// the workspace has: camera poses, depth maps, the fused cloud, the textured mesh and the
+// scene's novel views rendered from the workspace.
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "core/progress.h"
+#include "core/scene_folder.h"
+#include "core/workspace.h"
+#include "eval/cloud_evaluation.h"
+#include "eval/depth_evaluation.h"
+#include "eval/evaluate.h"
+#include "eval/mesh_evaluation.h"
+#include "eval/novel_evaluation.h"
+#include "reproject/workspace_depth.h"
+
+namespace parallax {
+
+// Where the novel cameras' poses come from, for workspace sources: registering their photos
+// into the SfM model (as novel-view benchmarks do), or the ground truth mapped through the
+// pose alignment.
+enum class NovelPoses { kRegistered, kAligned };
+
+struct EvaluateOptions {
+  // Compare in the frame found by the pose alignment; false: the identity (a workspace made
+  // with known cameras is in the ground truth's frame).
+  bool align = true;
+  // Render the novel views from the scene's ground-truth sources instead of the workspace's.
+  bool gt_sources = false;
+  // Only the novel views.
+  bool novel_only = false;
+  NovelPoses novel_poses = NovelPoses::kRegistered;
+  NovelViewSettings novel;
+};
+
+struct MeshEvaluation {
+  size_t triangles = 0;
+  size_t vertices = 0;
+  CloudAccuracy accuracy;     // Vertices against the ground-truth depth.
+  TexturedMeshScore texture;  // Renders from the workspace cameras against the photos.
+  std::filesystem::path render_dir;
+};
+
+struct NovelViewsEvaluation {
+  NovelEvaluation result;
+  bool gt_sources = false;
+  std::string poses;  // "ground truth", "registered" or "aligned".
+  int poses_registered = 0;
+  bool registration_tried = false;
+  std::string registration_note;  // What the registration did, when tried, and what it did not.
+  std::string depth_holes_note;   // Workspace sources: where their depth holes came from.
+  std::filesystem::path comparison_dir;
+};
+
+struct WorkspaceEvaluation {
+  PoseEvaluation poses;
+  std::optional<DepthEvaluation> depth;  // Present when some depth map has ground truth.
+  bool depth_aligned = true;
+  std::filesystem::path depth_error_dir;
+  bool depth_without_truth = false;  // Depth maps exist, none of a ground-truth image.
+  std::optional<CloudAccuracy> fused;
+  std::optional<MeshEvaluation> mesh;
+  std::optional<NovelViewsEvaluation> novel;
+  // Stage timings from reconstruct's report.json, when the workspace has them.
+  std::optional<std::map<std::string, double>> reconstruct_timings_s;
+};
+
+// Evaluates every part `workspace` has against `scene`, writing the comparison images under
+// workspace.EvaluationDir(). Throws BadInputError when the workspace has no model or a
+// ground-truth file cannot be read, ToolError when colmap fails to register held-out photos.
+WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFolder& scene,
+                                      const EvaluateOptions& options, Progress& progress);
+
+// The JSON evaluate writes (docs/design.md "evaluation.json").
+void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation);
+
+}  // namespace parallax

@@ -1,0 +1,188 @@
+#include "geometry/ply.h"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+size_t TypeSize(const std::string& type) {
+  static const std::map<std::string, size_t> sizes = {
+      {"char", 1},  {"uchar", 1}, {"int8", 1},   {"uint8", 1},   {"short", 2},
+      {"ushort", 2}, {"int16", 2}, {"uint16", 2}, {"int", 4},     {"uint", 4},
+      {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4}, {"double", 8},
+      {"float64", 8}};
+  const auto found = sizes.find(type);
+  return found == sizes.end() ? 0 : found->second;
+}
+
+struct Element {
+  std::string name;
+  size_t count = 0;
+  size_t stride = 0;  // Bytes per record for fixed-size elements.
+  std::vector<std::string> properties;  // "type name", or "list count_type index_type name".
+};
+
+struct Header {
+  std::vector<Element> elements;
+  size_t body = 0;  // Offset of the first data byte.
+};
+
+Header ParseHeader(const std::string& bytes, const fs::path& path) {
+  const std::string kEnd = "end_header\n";
+  const size_t end = bytes.find(kEnd);
+  if (!bytes.starts_with("ply\n") || end == std::string::npos) {
+    throw BadInputError(path.string() + ": not a PLY file");
+  }
+  Header header;
+  header.body = end + kEnd.size();
+  std::istringstream lines(bytes.substr(0, end));
+  bool little_endian = false;
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "format") {
+      std::string format;
+      words >> format;
+      little_endian = format == "binary_little_endian";
+    } else if (keyword == "element") {
+      Element element;
+      words >> element.name >> element.count;
+      if (!words) throw BadInputError(path.string() + ": malformed line '" + line + "'");
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) throw BadInputError(path.string() + ": property before element");
+      Element& element = header.elements.back();
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type, index_type, name;
+        words >> count_type >> index_type >> name;
+        if (TypeSize(count_type) == 0 || TypeSize(index_type) == 0) {
+          throw BadInputError(path.string() + ": unsupported list property '" + line + "'");
+        }
+        element.properties.push_back("list " + count_type + " " + index_type + " " + name);
+      } else {
+        std::string name;
+        words >> name;
+        if (TypeSize(type) == 0) {
+          throw BadInputError(path.string() + ": unsupported property type '" + type + "'");
+        }
+        element.stride += TypeSize(type);
+        element.properties.push_back(type + " " + name);
+      }
+    }
+  }
+  if (!little_endian) {
+    throw BadInputError(path.string() + ": only binary_little_endian PLY files are supported");
+  }
+  return header;
+}
+
+template <typename T>
+int64_t Load(const char* data) {
+  T value;
+  std::memcpy(&value, data, sizeof(T));
+  return static_cast<int64_t>(value);
+}
+
+// Integer value of a list count or index stored as `type`.
+int64_t LoadInteger(const std::string& type, const char* data) {
+  if (type == "uchar" || type == "uint8") return Load<uint8_t>(data);
+  if (type == "char" || type == "int8") return Load<int8_t>(data);
+  if (type == "ushort" || type == "uint16") return Load<uint16_t>(data);
+  if (type == "short" || type == "int16") return Load<int16_t>(data);
+  if (type == "uint" || type == "uint32") return Load<uint32_t>(data);
+  if (type == "int" || type == "int32") return Load<int32_t>(data);
+  return -1;  // Floating-point list types are not indices.
+}
+
+void ReadVertices(const std::string& bytes, const Element& element, size_t& offset,
+                  const fs::path& path, PlyMesh& mesh) {
+  if (element.properties.size() < 3 || element.properties[0] != "float x" ||
+      element.properties[1] != "float y" || element.properties[2] != "float z") {
+    throw BadInputError(path.string() + ": vertices must start with float x, y, z");
+  }
+  if (element.stride == 0 || (bytes.size() - offset) / element.stride < element.count) {
+    throw BadInputError(path.string() + ": " + std::to_string(element.count) +
+                        " vertices announced, the file is shorter");
+  }
+  mesh.vertices.resize(element.count);
+  for (size_t i = 0; i < element.count; ++i) {
+    std::memcpy(mesh.vertices[i].data(), bytes.data() + offset + i * element.stride, 12);
+    if (!mesh.vertices[i].allFinite()) {
+      throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
+    }
+  }
+  offset += element.count * element.stride;
+}
+
+void ReadFaces(const std::string& bytes, const Element& element, size_t& offset,
+               const fs::path& path, PlyMesh& mesh) {
+  std::istringstream list(element.properties.size() == 1 ? element.properties[0] : "");
+  std::string keyword, count_type, index_type, name;
+  list >> keyword >> count_type >> index_type >> name;
+  if (keyword != "list" || (name != "vertex_indices" && name != "vertex_index")) {
+    throw BadInputError(path.string() + ": faces must hold one vertex_indices list");
+  }
+  const size_t count_size = TypeSize(count_type), index_size = TypeSize(index_type);
+  const std::string truncated = path.string() + ": face data is truncated";
+  mesh.triangles.reserve(element.count);
+  for (size_t f = 0; f < element.count; ++f) {
+    if (bytes.size() - offset < count_size) throw BadInputError(truncated);
+    const int64_t corners = LoadInteger(count_type, bytes.data() + offset);
+    offset += count_size;
+    if (corners != 3) {
+      throw BadInputError(path.string() + ": face " + std::to_string(f) + " has " +
+                          std::to_string(corners) + " corners; only triangles are supported");
+    }
+    if ((bytes.size() - offset) / index_size < 3) throw BadInputError(truncated);
+    Eigen::Vector3i triangle;
+    for (int c = 0; c < 3; ++c) {
+      const int64_t index = LoadInteger(index_type, bytes.data() + offset);
+      offset += index_size;
+      if (index < 0 || index >= static_cast<int64_t>(mesh.vertices.size())) {
+        throw BadInputError(path.string() + ": face " + std::to_string(f) +
+                            " refers to vertex " + std::to_string(index) + " of " +
+                            std::to_string(mesh.vertices.size()));
+      }
+      triangle[c] = static_cast<int>(index);
+    }
+    mesh.triangles.push_back(triangle);
+  }
+}
+
+}  // namespace
+
+PlyMesh ReadPly(const fs::path& path) {
+  const std::string bytes = ReadFileBytes(path);
+  const Header header = ParseHeader(bytes, path);
+  PlyMesh mesh;
+  size_t offset = header.body;
+  bool has_vertices = false;
+  for (const Element& element : header.elements) {
+    if (element.name == "vertex") {
+      ReadVertices(bytes, element, offset, path, mesh);
+      has_vertices = true;
+    } else if (element.name == "face") {
+      if (!has_vertices) throw BadInputError(path.string() + ": faces before vertices");
+      ReadFaces(bytes, element, offset, path, mesh);
+    } else {
+      // Other elements come after the ones we read in every file we know; stop there.
+      break;
+    }
+  }
+  if (!has_vertices) throw BadInputError(path.string() + ": no vertex element");
+  return mesh;
+}
+
+}  // namespace parallax

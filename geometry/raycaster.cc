@@ -1,0 +1,152 @@
+#include "geometry/raycaster.h"
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace parallax {
+
+struct MeshRaycaster::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::string error;
+};
+
+MeshRaycaster::MeshRaycaster(const std::vector<Eigen::Vector3f>& vertices,
+                             const std::vector<Eigen::Vector3i>& triangles)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
+  rtcSetDeviceErrorFunction(
+      impl_->device,
+      [](void* user, RTCError, const char* message) {
+        static_cast<Impl*>(user)->error = message ? message : "unknown error";
+      },
+      impl_.get());
+  impl_->scene = rtcNewScene(impl_->device);
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  if (!triangles.empty()) {
+    RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertex_buffer = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+        vertices.size()));
+    auto* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+        triangles.size()));
+    if (!vertex_buffer || !index_buffer) throw std::runtime_error("Embree: " + impl_->error);
+    for (size_t i = 0; i < vertices.size(); ++i) {
+      std::copy_n(vertices[i].data(), 3, vertex_buffer + 3 * i);
+    }
+    for (size_t i = 0; i < triangles.size(); ++i) {
+      for (int k = 0; k < 3; ++k) index_buffer[3 * i + k] = static_cast<unsigned>(triangles[i][k]);
+    }
+    rtcCommitGeometry(geometry);
+    rtcAttachGeometry(impl_->scene, geometry);
+    rtcReleaseGeometry(geometry);
+  }
+  rtcCommitScene(impl_->scene);
+  if (!impl_->error.empty()) throw std::runtime_error("Embree: " + impl_->error);
+}
+
+MeshRaycaster::~MeshRaycaster() {
+  if (impl_->scene) rtcReleaseScene(impl_->scene);
+  if (impl_->device) rtcReleaseDevice(impl_->device);
+}
+
+namespace {
+
+RTCRay MakeRay(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, float tfar) {
+  RTCRay ray{};
+  ray.org_x = origin.x();
+  ray.org_y = origin.y();
+  ray.org_z = origin.z();
+  ray.dir_x = direction.x();
+  ray.dir_y = direction.y();
+  ray.dir_z = direction.z();
+  ray.tnear = 0;
+  ray.tfar = tfar;
+  ray.mask = ~0u;
+  return ray;
+}
+
+}  // namespace
+
+std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
+                                              const Rigid3d& cam_from_world) const {
+  if (camera.HasDistortion()) throw std::invalid_argument("CastPixels: camera has distortion");
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  std::vector<RayHit> hits(static_cast<size_t>(width) * height);
+  const Eigen::Matrix3d world_from_cam = cam_from_world.rotation.conjugate().toRotationMatrix();
+  const Eigen::Vector3f eye = CameraCenter(cam_from_world).cast<float>();
+  tbb::parallel_for(tbb::blocked_range<int>(0, height), [&](const tbb::blocked_range<int>& rows) {
+    std::vector<RTCRayHit> rays(static_cast<size_t>(width));
+    for (int y = rows.begin(); y < rows.end(); ++y) {
+      for (int x = 0; x < width; ++x) {
+        // z = 1 in the camera frame: the hit distance is the z-depth.
+        const Eigen::Vector3d in_cam((x + 0.5 - camera.PrincipalX()) / camera.FocalX(),
+                                     (y + 0.5 - camera.PrincipalY()) / camera.FocalY(), 1.0);
+        RTCRayHit& ray = rays[static_cast<size_t>(x)];
+        ray.ray = MakeRay(eye, (world_from_cam * in_cam).cast<float>(),
+                          std::numeric_limits<float>::infinity());
+        ray.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        ray.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      }
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      rtcIntersect1M(impl_->scene, &context, rays.data(), static_cast<unsigned>(width),
+                     sizeof(RTCRayHit));
+      for (int x = 0; x < width; ++x) {
+        const RTCRayHit& ray = rays[static_cast<size_t>(x)];
+        if (ray.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+        hits[static_cast<size_t>(y) * width + x] = {static_cast<int>(ray.hit.primID),
+                                                    ray.ray.tfar, ray.hit.u, ray.hit.v};
+      }
+    }
+  });
+  return hits;
+}
+
+namespace {
+
+// Whether each of `count` segments (ray i from make_segment(i), t in [0, tfar]) is free of the
+// mesh, in batches over all threads.
+template <typename MakeSegment>
+std::vector<uint8_t> FreeSegments(RTCScene scene, size_t count, const MakeSegment& make_segment) {
+  std::vector<uint8_t> free(count, 0);
+  constexpr size_t kBatch = 1024;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, kBatch), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<RTCRay> rays(range.size());
+    for (size_t i = range.begin(); i < range.end(); ++i) rays[i - range.begin()] = make_segment(i);
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    rtcOccluded1M(scene, &context, rays.data(), static_cast<unsigned>(rays.size()), sizeof(RTCRay));
+    for (size_t i = range.begin(); i < range.end(); ++i) {
+      // rtcOccluded sets tfar to -inf when something blocks the segment.
+      free[i] = rays[i - range.begin()].tfar >= 0 ? 1 : 0;
+    }
+  });
+  return free;
+}
+
+}  // namespace
+
+std::vector<uint8_t> MeshRaycaster::Visible(const Eigen::Vector3f& eye,
+                                            const std::vector<Eigen::Vector3f>& points,
+                                            float tolerance) const {
+  // Direction = the whole segment, so t runs from 0 (eye) to 1 (point).
+  return FreeSegments(impl_->scene, points.size(),
+                      [&](size_t i) { return MakeRay(eye, points[i] - eye, 1.0f - tolerance); });
+}
+
+std::vector<uint8_t> MeshRaycaster::Unoccluded(const std::vector<Eigen::Vector3f>& origins,
+                                               const Eigen::Vector3f& direction, float length) const {
+  const Eigen::Vector3f unit = direction.normalized();
+  return FreeSegments(impl_->scene, origins.size(), [&](size_t i) { return MakeRay(origins[i], unit, length); });
+}
+
+}  // namespace parallax

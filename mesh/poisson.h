@@ -1,0 +1,54 @@
+#pragma once
+// The mesh stage of `parallax reconstruct`: fused cloud -> `colmap poisson_mesher` (screened
+// Poisson, watertight) -> trimmed to where the cloud has data -> textured from the photos ->
+// <ws>/mesh/mesh.obj|.mtl|.png, and a simplified copy for display -> <ws>/mesh_display/.
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "core/progress.h"
+#include "colmap/runner.h"
+#include "core/quality.h"
+#include "mesh/texture.h"
+
+namespace parallax {
+
+struct MeshOptions {
+  // Octree depth of the Poisson solve: cells of (scene extent / 2^depth).
+  int poisson_depth = 10;
+  // Poisson closes the surface everywhere, also where no photo saw anything; a triangle is
+  // kept only if each of its corners lies within this many octree cells of a fused point.
+  double max_cells_from_data = 2;
+  // The viewer's level of detail: a mesh with more triangles also gets a simplified copy with
+  // at most this many (about one per 28 pixels of a 1280x720 view), textured on its own, which
+  // the viewer draws when the full mesh would have more triangles than the pixels need.
+  size_t display_max_triangles = 32768;
+  TextureOptions texture;
+  void Check() const;
+};
+
+// fast: depth 9; balanced: 10; best: 11 (each level about 4x the triangles and 2x the time).
+MeshOptions MeshOptionsFor(Quality quality);
+
+struct MeshSummary {
+  size_t poisson_triangles = 0;
+  size_t triangles = 0;  // After trimming.
+  size_t vertices = 0;
+  int texels_per_edge = 0;
+  size_t untextured_triangles = 0;
+  int atlas_width = 0, atlas_height = 0;
+  size_t display_triangles = 0;  // 0: the mesh is small enough to display as it is.
+};
+
+// <ws>/mesh/summary.json and report.json's "mesh" section.
+void to_json(nlohmann::json& json, const MeshSummary& mesh);
+void from_json(const nlohmann::json& json, MeshSummary& mesh);
+
+// Reads <ws>/fused.ply, <ws>/sparse and <ws>/images; writes <ws>/mesh/ and <ws>/mesh_display/
+// (each atomically; the latter only for a mesh over the display budget, else it is removed) and
+// the raw Poisson mesh to <ws>/mesh_poisson.ply. Throws BadInputError for an empty cloud,
+// ToolError if colmap fails.
+MeshSummary MeshWorkspace(const std::filesystem::path& workspace, const Colmap& colmap,
+                          const MeshOptions& options, Progress& progress);
+
+}  // namespace parallax

@@ -1,0 +1,241 @@
+#include "mesh/texture.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "geometry/raycaster.h"
+#include "core/check.h"
+
+namespace parallax {
+namespace {
+
+struct Candidate {
+  int view = -1;
+  float score = 0;
+};
+constexpr int kMaxCandidates = 8;
+// How far beyond a photo's border a texel may lie and still take the border's colour.
+constexpr float kBorderPixels = 4;
+using Candidates = std::array<Candidate, kMaxCandidates>;  // Best first; view -1 ends the list.
+
+Eigen::Vector3f Centroid(const std::vector<Eigen::Vector3f>& vertices, const Eigen::Vector3i& t) {
+  return (vertices[static_cast<size_t>(t[0])] + vertices[static_cast<size_t>(t[1])] +
+          vertices[static_cast<size_t>(t[2])]) / 3.0f;
+}
+
+// Pixel position of a world point in a distortion-free camera; false behind it.
+bool ProjectPinhole(const TextureView& view, const Eigen::Vector3f& world, Eigen::Vector2f& pixel,
+                    float& depth) {
+  const Eigen::Vector3d p = view.cam_from_world * world.cast<double>();
+  if (!(p.z() > 0)) return false;
+  pixel = Eigen::Vector2f(static_cast<float>(view.camera.FocalX() * p.x() / p.z() + view.camera.PrincipalX()),
+                          static_cast<float>(view.camera.FocalY() * p.y() / p.z() + view.camera.PrincipalY()));
+  depth = static_cast<float>(p.z());
+  return pixel.allFinite();
+}
+
+bool Inside(const TextureView& view, const Eigen::Vector2f& pixel, float margin) {
+  return pixel.x() >= margin && pixel.y() >= margin &&
+         pixel.x() <= static_cast<float>(view.camera.width) - margin &&
+         pixel.y() <= static_cast<float>(view.camera.height) - margin;
+}
+
+// Whether the pixel box [low, high] overlaps the photo.
+bool Overlaps(const TextureView& view, const Eigen::Vector2f& low, const Eigen::Vector2f& high) {
+  return high.x() >= 0 && high.y() >= 0 && low.x() <= static_cast<float>(view.camera.width) &&
+         low.y() <= static_cast<float>(view.camera.height);
+}
+
+void Insert(Candidates& list, Candidate candidate, int limit) {
+  for (int i = 0; i < limit; ++i) {
+    if (list[static_cast<size_t>(i)].view < 0 || candidate.score > list[static_cast<size_t>(i)].score) {
+      std::swap(list[static_cast<size_t>(i)], candidate);
+      if (candidate.view < 0) return;
+    }
+  }
+}
+
+// For every triangle, the photos that see it unoccluded, best first. The score is the
+// triangle's area in the photo's pixels, which falls with obliqueness and distance alike.
+std::vector<Candidates> RankViews(const std::vector<Eigen::Vector3f>& vertices,
+                                  const std::vector<Eigen::Vector3i>& triangles,
+                                  const std::vector<TextureView>& views,
+                                  const TextureOptions& options) {
+  std::vector<Candidates> ranked(triangles.size());
+  std::vector<Eigen::Vector3f> centroids(triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) centroids[t] = Centroid(vertices, triangles[t]);
+  const MeshRaycaster raycaster(vertices, triangles);
+  const float min_cos = static_cast<float>(std::cos(options.max_view_angle_deg * std::numbers::pi / 180));
+  for (size_t v = 0; v < views.size(); ++v) {
+    const TextureView& view = views[v];
+    const Eigen::Vector3f eye = CameraCenter(view.cam_from_world).cast<float>();
+    const std::vector<uint8_t> visible = raycaster.Visible(eye, centroids, 1e-3f);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()),
+                      [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t t = range.begin(); t < range.end(); ++t) {
+        if (!visible[t]) continue;
+        const Eigen::Vector3i& tri = triangles[t];
+        // In view: every corner in front of the camera, and the triangle's bounding box
+        // overlapping the photo (texels beyond its border take the border's colour).
+        std::array<Eigen::Vector2f, 3> pixels;
+        bool in_front = true;
+        for (int c = 0; c < 3 && in_front; ++c) {
+          float depth = 0;
+          in_front = ProjectPinhole(view, vertices[static_cast<size_t>(tri[c])],
+                                    pixels[static_cast<size_t>(c)], depth);
+        }
+        if (!in_front || !Overlaps(view, pixels[0].cwiseMin(pixels[1]).cwiseMin(pixels[2]),
+                                   pixels[0].cwiseMax(pixels[1]).cwiseMax(pixels[2]))) {
+          continue;
+        }
+        const Eigen::Vector3f normal = (vertices[static_cast<size_t>(tri[1])] - vertices[static_cast<size_t>(tri[0])])
+                                           .cross(vertices[static_cast<size_t>(tri[2])] - vertices[static_cast<size_t>(tri[0])]);
+        const Eigen::Vector3f ray = centroids[t] - eye;
+        const float norms = normal.norm() * ray.norm();
+        if (!(norms > 0) || std::abs(normal.dot(ray)) < min_cos * norms) continue;
+        const Eigen::Vector2f e1 = pixels[1] - pixels[0], e2 = pixels[2] - pixels[0];
+        const float area = 0.5f * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+        Insert(ranked[t], {static_cast<int>(v), area}, options.max_views_per_triangle);
+      }
+    });
+  }
+  return ranked;
+}
+
+// Median over textured triangles of the longest edge in the best photo, in pixels.
+double MedianEdgePixels(const std::vector<Eigen::Vector3f>& vertices,
+                        const std::vector<Eigen::Vector3i>& triangles,
+                        const std::vector<TextureView>& views,
+                        const std::vector<Candidates>& ranked) {
+  std::vector<float> edges;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (ranked[t][0].view < 0) continue;
+    const TextureView& view = views[static_cast<size_t>(ranked[t][0].view)];
+    std::array<Eigen::Vector2f, 3> pixels;
+    float depth = 0;
+    for (int c = 0; c < 3; ++c) {
+      ProjectPinhole(view, vertices[static_cast<size_t>(triangles[t][c])], pixels[static_cast<size_t>(c)], depth);
+    }
+    edges.push_back(std::max({(pixels[1] - pixels[0]).norm(), (pixels[2] - pixels[0]).norm(),
+                              (pixels[2] - pixels[1]).norm()}));
+  }
+  if (edges.empty()) return 0;
+  std::nth_element(edges.begin(), edges.begin() + static_cast<std::ptrdiff_t>(edges.size() / 2), edges.end());
+  return static_cast<double>(edges[edges.size() / 2]);
+}
+
+// Linear colour of a surface point from the triangle's ranked photos.
+Eigen::Vector3f BlendedColour(const Eigen::Vector3f& point, const Candidates& candidates,
+                              const std::vector<TextureView>& views, double exponent) {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float total = 0;
+  for (const Candidate& candidate : candidates) {
+    if (candidate.view < 0) break;
+    const TextureView& view = views[static_cast<size_t>(candidate.view)];
+    Eigen::Vector2f pixel;
+    float depth = 0;
+    if (!ProjectPinhole(view, point, pixel, depth) || !Inside(view, pixel, -kBorderPixels)) continue;
+    const float weight = static_cast<float>(
+        std::pow(static_cast<double>(candidate.score / candidates[0].score), exponent));
+    sum += weight * SampleBilinear(view.colour, pixel);
+    total += weight;
+  }
+  return total > 0 ? Eigen::Vector3f(sum / total) : Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
+}
+
+}  // namespace
+
+void TextureOptions::Check() const {
+  RequireOption(min_texels_per_edge >= 1, "TextureOptions.min_texels_per_edge", min_texels_per_edge, ">= 1");
+  RequireOption(max_texels_per_edge >= min_texels_per_edge, "TextureOptions.max_texels_per_edge",
+                max_texels_per_edge, ">= min_texels_per_edge");
+  RequireOption(max_views_per_triangle >= 1 && max_views_per_triangle <= kMaxCandidates,
+                "TextureOptions.max_views_per_triangle", max_views_per_triangle,
+                "[1, " + std::to_string(kMaxCandidates) + "]");
+  RequireOption(blend_exponent >= 0, "TextureOptions.blend_exponent", blend_exponent, ">= 0");
+  RequireOption(max_view_angle_deg > 0 && max_view_angle_deg < 90, "TextureOptions.max_view_angle_deg",
+                max_view_angle_deg, "(0, 90)");
+}
+
+TexturedMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
+                         const std::vector<Eigen::Vector3i>& triangles,
+                         const std::vector<TextureView>& views, const TextureOptions& options,
+                         TextureSummary& summary) {
+  options.Check();
+  for (const TextureView& view : views) {
+    if (view.camera.HasDistortion() || static_cast<uint64_t>(view.colour.Width()) != view.camera.width ||
+        static_cast<uint64_t>(view.colour.Height()) != view.camera.height || view.colour.Channels() < 3) {
+      throw std::invalid_argument("texture: views must be distortion-free with RGB images of the camera's size");
+    }
+  }
+  const std::vector<Candidates> ranked = RankViews(vertices, triangles, views, options);
+
+  // One square cell per triangle: the triangle fills the lower-left half of the cell's inner
+  // part, one texel of margin all round. Texels outside the triangle repeat its nearest point,
+  // so bilinear filtering never reaches a neighbour's colours.
+  const double cells_per_side = std::ceil(std::sqrt(static_cast<double>(std::max<size_t>(triangles.size(), 1))));
+  const int largest_edge = static_cast<int>(options.max_atlas_size / cells_per_side) - 2;
+  const int texels = std::clamp(static_cast<int>(std::ceil(MedianEdgePixels(vertices, triangles, views, ranked))),
+                                options.min_texels_per_edge,
+                                std::max(options.min_texels_per_edge, std::min(options.max_texels_per_edge, largest_edge)));
+  const int cell = texels + 2;
+  const int columns = static_cast<int>(cells_per_side);
+  const int rows = static_cast<int>((static_cast<int>(triangles.size()) + columns - 1) / columns);
+  summary.texels_per_edge = texels;
+
+  TexturedMesh mesh;
+  mesh.vertices = vertices;
+  mesh.triangles = triangles;
+  mesh.atlas = Image(columns * cell, std::max(rows, 1) * cell, 3);
+  mesh.corner_uvs.resize(3 * triangles.size());
+  const float width = static_cast<float>(mesh.atlas.Width());
+  const float height = static_cast<float>(mesh.atlas.Height());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()),
+                    [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t t = range.begin(); t < range.end(); ++t) {
+      const int cell_x = static_cast<int>(t) % columns * cell;
+      const int cell_y = static_cast<int>(t) / columns * cell;
+      // Corner 0 at the inner lower-left, 1 along the row, 2 along the column (image rows
+      // run down; the OBJ v axis runs up).
+      const Eigen::Vector2f origin(static_cast<float>(cell_x + 1), static_cast<float>(cell_y + 1));
+      const float leg = static_cast<float>(texels);
+      const std::array<Eigen::Vector2f, 3> corners = {
+          origin, origin + Eigen::Vector2f(leg, 0), origin + Eigen::Vector2f(0, leg)};
+      for (int c = 0; c < 3; ++c) {
+        mesh.corner_uvs[3 * t + static_cast<size_t>(c)] =
+            Eigen::Vector2f(corners[static_cast<size_t>(c)].x() / width, 1.0f - corners[static_cast<size_t>(c)].y() / height);
+      }
+      const Eigen::Vector3i& tri = triangles[t];
+      const Eigen::Vector3f& v0 = vertices[static_cast<size_t>(tri[0])];
+      const Eigen::Vector3f e1 = vertices[static_cast<size_t>(tri[1])] - v0;
+      const Eigen::Vector3f e2 = vertices[static_cast<size_t>(tri[2])] - v0;
+      for (int j = 0; j < cell; ++j) {
+        for (int i = 0; i < cell; ++i) {
+          float a = std::max(0.0f, (static_cast<float>(i) - 0.5f) / leg);
+          float b = std::max(0.0f, (static_cast<float>(j) - 0.5f) / leg);
+          if (a + b > 1) {
+            const float sum = a + b;
+            a /= sum;
+            b /= sum;
+          }
+          const Eigen::Vector3f colour =
+              BlendedColour(v0 + a * e1 + b * e2, ranked[t], views, options.blend_exponent);
+          for (int c = 0; c < 3; ++c) {
+            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(colour[c]), 0.0f, 1.0f);
+          }
+        }
+      }
+    }
+  });
+  summary.untextured_triangles = static_cast<size_t>(
+      std::count_if(ranked.begin(), ranked.end(), [](const Candidates& c) { return c[0].view < 0; }));
+  return mesh;
+}
+
+}  // namespace parallax

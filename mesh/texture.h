@@ -1,0 +1,49 @@
+#pragma once
+// Texturing a mesh from the photos: every triangle gets its own cell in one atlas, coloured
+// from the photo that sees it best (most head-on and most pixels per unit area) without
+// occlusion (Embree visibility). Photos nearly as good are blended in with a steeply falling
+// weight, so the seam between triangles that chose different photos fades instead of jumping.
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/camera.h"
+#include "core/image.h"
+#include "core/pose.h"
+#include "geometry/textured_mesh.h"
+
+namespace parallax {
+
+struct TextureView {
+  Camera camera;  // Distortion-free (the undistorted workspace).
+  Rigid3d cam_from_world;
+  Image colour;   // Linear RGB, camera.width x camera.height.
+};
+
+struct TextureOptions {
+  // Texels along a triangle's legs: the median projected size of the triangles in their best
+  // photos (texel ~ pixel), clamped to this range, and lowered if the atlas would exceed
+  // `max_atlas_size` on a side.
+  int min_texels_per_edge = 2;
+  int max_texels_per_edge = 16;
+  int max_atlas_size = 8192;
+  // Photos blended per triangle, and the exponent of their weight (score / best score).
+  int max_views_per_triangle = 4;
+  double blend_exponent = 8;
+  // A photo sees a triangle when the angle between its ray and the normal is below this.
+  double max_view_angle_deg = 80;
+  void Check() const;
+};
+
+struct TextureSummary {
+  int texels_per_edge = 0;
+  size_t untextured_triangles = 0;  // No photo sees them: mid-grey.
+};
+
+// Throws std::invalid_argument for invalid options or views.
+TexturedMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
+                         const std::vector<Eigen::Vector3i>& triangles,
+                         const std::vector<TextureView>& views, const TextureOptions& options,
+                         TextureSummary& summary);
+
+}  // namespace parallax

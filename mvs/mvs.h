@@ -1,0 +1,73 @@
+#pragma once
+// Multi-view stereo over a workspace: for every view of <ws>/sparse (undistorted PINHOLE),
+// PatchMatch against its selected source views, then the geometric-consistency filter; writes
+// docs/design.md's dense files (COLMAP format under <ws>/stereo, EXR depth + confidence under
+// <ws>/depth).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/progress.h"
+#include "mvs/depth_filter.h"
+#include "mvs/patch_match.h"
+#include "core/quality.h"
+#include "mvs/view_selection.h"
+
+namespace parallax {
+
+struct MvsOptions {
+  ViewSelectionOptions views;
+  PatchMatchOptions patch_match;  // Its depth range is set per view from the sparse points.
+  GeometricFilterOptions filter;
+  // Only these views (image names) get depth maps; empty means every view. Their first
+  // `filter_sources` source views are estimated too (photometric only, not written), since
+  // the geometric filter checks each depth against its sources' estimates.
+  std::vector<std::string> only_views;
+  int filter_sources = 2;
+  // Resolution of the estimate, as a share of each side (0.25..1): the photos are resampled to
+  // it, and the depth maps upsampled back (nearest, never blending depths across an edge) so
+  // every file keeps the photo's size. Half resolution is about 4x faster.
+  double image_scale = 1;
+  void Check() const;
+};
+
+// fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
+// balanced: 5 sources, 4x4 samples, 3 iterations, near and far neighbours;
+// best: 7 sources, 4 iterations.
+MvsOptions MvsOptionsFor(Quality quality);
+
+struct MvsViewReport {
+  std::string name;
+  std::vector<std::string> sources;
+  double min_depth = 0;
+  double max_depth = 0;
+  double photometric_share = 0;  // Share of pixels with a photometric depth.
+  double geometric_share = 0;    // Share left after the geometric filter.
+};
+
+struct MvsSummary {
+  std::vector<MvsViewReport> views;  // The views whose depth maps were written.
+  int estimated_views = 0;           // Views PatchMatch ran on (more than `views` with only_views).
+  std::vector<std::string> skipped;  // Views without depth, and why.
+  double photometric_seconds = 0;
+  double geometric_seconds = 0;
+};
+
+// <ws>/depth/views.json and report.json's "depth" section.
+void to_json(nlohmann::json& json, const MvsViewReport& view);
+void from_json(const nlohmann::json& json, MvsViewReport& view);
+void to_json(nlohmann::json& json, const MvsSummary& summary);
+void from_json(const nlohmann::json& json, MvsSummary& summary);
+
+// Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
+MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,
+                              Progress& progress);
+
+// Depth at pixel centres (our convention) -> depth sampled at integer image points (x, y), as
+// COLMAP's dense code reads its maps: inverse depth averaged over the four surrounding pixel
+// centres where they agree (within 1%), else the pixel's own value.
+DepthMap ToColmapSampling(const DepthMap& depth);
+
+}  // namespace parallax

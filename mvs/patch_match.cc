@@ -1,0 +1,517 @@
+#include "mvs/patch_match.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/hash.h"
+#include "core/check.h"
+
+namespace parallax {
+namespace {
+
+constexpr float kInvalidCost = 2.0f;
+constexpr int kMaxSources = 16;
+
+// Deterministic per-pixel randomness: the same numbers whatever the thread schedule.
+float Random(uint32_t seed, int x, int y, int iteration, int salt) {
+  uint64_t h = seed * 0x9E3779B97F4A7C15ull;
+  h ^= (static_cast<uint64_t>(x) << 32 | static_cast<uint32_t>(y)) * 0xC2B2AE3D27D4EB4Full;
+  h ^= (static_cast<uint64_t>(iteration) << 8 | static_cast<uint64_t>(salt)) * 0x165667B19E3779F9ull;
+  return UnitFloat(MixBits(h));
+}
+
+Eigen::Matrix3d Intrinsics(const Camera& camera) {
+  Eigen::Matrix3d k;
+  k << camera.FocalX(), 0, camera.PrincipalX(), 0, camera.FocalY(), camera.PrincipalY(), 0, 0, 1;
+  return k;
+}
+
+void CheckPinhole(const Camera& camera, const GrayImage& image) {
+  if (camera.model != CameraModel::kPinhole && camera.model != CameraModel::kSimplePinhole) {
+    throw std::invalid_argument("PatchMatchStereo needs undistorted PINHOLE cameras, got " +
+                                std::string(CameraModelName(camera.model)));
+  }
+  if (static_cast<uint64_t>(image.width) != camera.width ||
+      static_cast<uint64_t>(image.height) != camera.height ||
+      image.values.size() != static_cast<size_t>(image.width) * image.height) {
+    throw std::invalid_argument("PatchMatchStereo: image size does not match its camera");
+  }
+}
+
+float Bilinear(const GrayImage& image, float u, float v) {
+  const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
+  const float ax = u - static_cast<float>(x0), ay = v - static_cast<float>(y0);
+  const float* row0 = image.values.data() + static_cast<size_t>(y0) * image.width + x0;
+  const float* row1 = row0 + image.width;
+  return (1 - ay) * ((1 - ax) * row0[0] + ax * row0[1]) + ay * ((1 - ax) * row1[0] + ax * row1[1]);
+}
+
+// The sampling pattern of the matching window and its spatial weights.
+struct WindowPattern {
+  std::vector<float> dx, dy, spatial_weight;
+  explicit WindowPattern(const PatchMatchOptions& options) {
+    for (int y = -options.window_radius; y <= options.window_radius; y += options.window_step) {
+      for (int x = -options.window_radius; x <= options.window_radius; x += options.window_step) {
+        dx.push_back(static_cast<float>(x));
+        dy.push_back(static_cast<float>(y));
+        const float r2 = static_cast<float>(x * x + y * y);
+        spatial_weight.push_back(
+            std::exp(-r2 / (2 * options.sigma_spatial_px * options.sigma_spatial_px)));
+      }
+    }
+  }
+  int Size() const { return static_cast<int>(dx.size()); }
+};
+
+// The reference side of the NCC, computed once per pixel: normalised bilateral weights w,
+// w * I, and the weighted mean and standard deviation of I.
+struct ReferenceWindow {
+  const float* weights;
+  const float* weighted_values;
+  float mean;
+  float stddev;
+};
+
+class ReferenceWindows {
+ public:
+  ReferenceWindows(const GrayImage& image, const WindowPattern& pattern,
+                   const PatchMatchOptions& options)
+      : samples_(pattern.Size()), width_(image.width) {
+    const size_t pixels = static_cast<size_t>(image.width) * image.height;
+    weights_.resize(pixels * samples_);
+    weighted_values_.resize(pixels * samples_);
+    mean_.resize(pixels);
+    stddev_.resize(pixels);
+    tbb::parallel_for(0, image.height, [&](int y) {
+      for (int x = 0; x < image.width; ++x) Compute(image, pattern, options, x, y);
+    });
+  }
+
+  ReferenceWindow At(int x, int y) const {
+    const size_t i = static_cast<size_t>(y) * width_ + x;
+    return {&weights_[i * samples_], &weighted_values_[i * samples_], mean_[i], stddev_[i]};
+  }
+
+ private:
+  void Compute(const GrayImage& image, const WindowPattern& pattern,
+               const PatchMatchOptions& options, int x, int y) {
+    const size_t i = static_cast<size_t>(y) * width_ + x;
+    float* w = &weights_[i * samples_];
+    float* wi = &weighted_values_[i * samples_];
+    const float centre = image.At(x, y);
+    float sum = 0;
+    for (int k = 0; k < samples_; ++k) {
+      // Samples outside the image are clamped to the border: the source sampling decides.
+      const int sx = std::clamp(x + static_cast<int>(pattern.dx[k]), 0, image.width - 1);
+      const int sy = std::clamp(y + static_cast<int>(pattern.dy[k]), 0, image.height - 1);
+      const float value = image.At(sx, sy);
+      const float difference = value - centre;
+      w[k] = pattern.spatial_weight[k] *
+             std::exp(-difference * difference / (2 * options.sigma_color * options.sigma_color));
+      wi[k] = value;
+      sum += w[k];
+    }
+    float mean = 0, mean_square = 0;
+    for (int k = 0; k < samples_; ++k) {
+      w[k] /= sum;
+      mean += w[k] * wi[k];
+      mean_square += w[k] * wi[k] * wi[k];
+      wi[k] *= w[k];
+    }
+    mean_[i] = mean;
+    stddev_[i] = std::sqrt(std::max(0.0f, mean_square - mean * mean));
+  }
+
+  int samples_;
+  int width_;
+  std::vector<float> weights_, weighted_values_, mean_, stddev_;
+};
+
+// Source-side constants: H(plane) = A + b m^T with m = K_r^-T n / rho.
+struct SourceProjection {
+  const GrayImage* image;
+  Eigen::Matrix3f a;
+  Eigen::Vector3f b;
+  float max_u, max_v;  // Bilinear lookups need u < width - 1 after the -0.5 shift.
+};
+
+// 1 - NCC of one source for a homography, given the reference window.
+float SourceCost(const SourceProjection& source, const Eigen::Matrix3f& h, float px, float py,
+                 const ReferenceWindow& reference, const WindowPattern& pattern,
+                 float min_std) {
+  const Eigen::Vector3f h0 = h * Eigen::Vector3f(px, py, 1);
+  const Eigen::Vector3f hx = h.col(0), hy = h.col(1);
+  float sum_j = 0, sum_jj = 0, sum_ij = 0;
+  const int samples = pattern.Size();
+  for (int k = 0; k < samples; ++k) {
+    const Eigen::Vector3f p = h0 + pattern.dx[k] * hx + pattern.dy[k] * hy;
+    if (!(p.z() > 1e-6f)) return kInvalidCost;
+    const float u = p.x() / p.z() - 0.5f, v = p.y() / p.z() - 0.5f;
+    if (!(u >= 0 && v >= 0 && u < source.max_u && v < source.max_v)) return kInvalidCost;
+    const float j = Bilinear(*source.image, u, v);
+    sum_j += reference.weights[k] * j;
+    sum_jj += reference.weights[k] * j * j;
+    sum_ij += reference.weighted_values[k] * j;
+  }
+  const float variance = sum_jj - sum_j * sum_j;
+  if (!(variance > min_std * min_std)) return kInvalidCost;
+  const float ncc = (sum_ij - reference.mean * sum_j) / (reference.stddev * std::sqrt(variance));
+  return 1 - std::clamp(ncc, -1.0f, 1.0f);
+}
+
+class PatchMatcher {
+ public:
+  // `initial` (may be null) proposes a plane per pixel, e.g. from a coarser pyramid level;
+  // pixels without one (depth 0) start from a random plane.
+  PatchMatcher(const StereoView& reference, const std::vector<const StereoView*>& sources,
+               const PatchMatchOptions& options, const DepthNormalMap* initial)
+      : initial_(initial),
+        options_(options),
+        pattern_(options),
+        windows_(reference.image, pattern_, options),
+        width_(reference.image.width),
+        height_(reference.image.height),
+        inverse_min_(static_cast<float>(1 / options.max_depth)),
+        inverse_max_(static_cast<float>(1 / options.min_depth)),
+        min_cos_normal_(static_cast<float>(std::cos(options.max_normal_angle_deg * std::numbers::pi / 180))),
+        best_views_(std::min(options.best_views, static_cast<int>(sources.size()))) {
+    const Eigen::Matrix3d k_ref = Intrinsics(reference.camera);
+    k_ref_inverse_ = k_ref.inverse().cast<float>();
+    for (const StereoView* source : sources) {
+      const Rigid3d source_from_ref = RelativePose(reference.cam_from_world, source->cam_from_world);
+      const Eigen::Matrix3d k_source = Intrinsics(source->camera);
+      sources_.push_back(
+          {&source->image,
+           (k_source * source_from_ref.rotation.toRotationMatrix() * k_ref.inverse()).cast<float>(),
+           (k_source * source_from_ref.translation).cast<float>(),
+           static_cast<float>(source->image.width - 1), static_cast<float>(source->image.height - 1)});
+    }
+    const size_t pixels = static_cast<size_t>(width_) * height_;
+    result_.depth = DepthMap(width_, height_);
+    result_.normal.assign(pixels * 3, 0.0f);
+    result_.cost.assign(pixels, kInvalidCost);
+  }
+
+  DepthNormalMap Run() {
+    ForEachPixel(-1, [&](int x, int y) { Initialise(x, y); });
+    for (int iteration = 0; iteration < options_.iterations; ++iteration) {
+      for (int colour = 0; colour < 2; ++colour) {
+        ForEachPixel(colour, [&](int x, int y) { Improve(x, y, iteration); });
+      }
+    }
+    // Keep only confident depths.
+    for (size_t i = 0; i < result_.cost.size(); ++i) {
+      if (result_.cost[i] > options_.max_cost) {
+        result_.depth.Values()[i] = 0;
+        std::fill_n(&result_.normal[3 * i], 3, 0.0f);
+      }
+    }
+    return std::move(result_);
+  }
+
+ private:
+  struct Plane {
+    float depth;
+    Eigen::Vector3f normal;
+  };
+
+  // Calls f(x, y) on every pixel of one checkerboard colour (-1: all), rows in parallel.
+  template <typename F>
+  void ForEachPixel(int colour, const F& f) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height_, 4), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y != rows.end(); ++y) {
+        const int start = colour < 0 ? 0 : (y + colour) % 2;
+        const int step = colour < 0 ? 1 : 2;
+        for (int x = start; x < width_; x += step) f(x, y);
+      }
+    });
+  }
+
+  Eigen::Vector3f Ray(int x, int y) const {
+    return k_ref_inverse_ * Eigen::Vector3f(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f, 1);
+  }
+
+  size_t Index(int x, int y) const { return static_cast<size_t>(y) * width_ + x; }
+
+  bool Textured(int x, int y) const {
+    return windows_.At(x, y).stddev >= options_.min_texture_std;
+  }
+
+  float Cost(int x, int y, const Plane& plane) const {
+    const Eigen::Vector3f ray = Ray(x, y);
+    const float n_dot_ray = plane.normal.dot(ray);
+    const float rho = plane.depth * n_dot_ray;
+    const Eigen::Vector3f m = k_ref_inverse_.transpose() * plane.normal / rho;
+    const ReferenceWindow window = windows_.At(x, y);
+    std::array<float, kMaxSources> costs;
+    const int n = static_cast<int>(sources_.size());
+    for (int s = 0; s < n; ++s) {
+      const Eigen::Matrix3f h = sources_[s].a + sources_[s].b * m.transpose();
+      costs[s] = SourceCost(sources_[s], h, static_cast<float>(x) + 0.5f,
+                            static_cast<float>(y) + 0.5f, window, pattern_,
+                            options_.min_texture_std);
+    }
+    // Occlusion-aware: only the best views count.
+    std::partial_sort(costs.begin(), costs.begin() + best_views_, costs.begin() + n);
+    float sum = 0;
+    for (int s = 0; s < best_views_; ++s) sum += costs[s];
+    return sum / static_cast<float>(best_views_);
+  }
+
+  Eigen::Vector3f RandomNormal(int x, int y, int iteration, int salt) const {
+    const Eigen::Vector3f view = -Ray(x, y).normalized();
+    for (int attempt = 0; attempt < 8; ++attempt) {
+      // Uniform direction on the sphere, flipped towards the camera.
+      const float z = 2 * Random(options_.seed, x, y, iteration, salt + 2 * attempt) - 1;
+      const float phi = 2 * std::numbers::pi_v<float> * Random(options_.seed, x, y, iteration, salt + 2 * attempt + 1);
+      const float r = std::sqrt(std::max(0.0f, 1 - z * z));
+      Eigen::Vector3f normal(r * std::cos(phi), r * std::sin(phi), z);
+      if (normal.dot(view) < 0) normal = -normal;
+      if (normal.dot(view) >= min_cos_normal_) return normal;
+    }
+    return view;
+  }
+
+  float RandomDepth(int x, int y, int iteration, int salt) const {
+    const float inverse = inverse_min_ + Random(options_.seed, x, y, iteration, salt) * (inverse_max_ - inverse_min_);
+    return 1 / inverse;
+  }
+
+  bool Acceptable(int x, int y, const Plane& plane) const {
+    if (!(plane.depth >= 1 / inverse_max_ && plane.depth <= 1 / inverse_min_)) return false;
+    return plane.normal.dot(-Ray(x, y).normalized()) >= min_cos_normal_;
+  }
+
+  void Store(int x, int y, const Plane& plane, float cost) {
+    const size_t i = Index(x, y);
+    result_.depth.Values()[i] = plane.depth;
+    std::copy_n(plane.normal.data(), 3, &result_.normal[3 * i]);
+    result_.cost[i] = cost;
+  }
+
+  Plane StoredPlane(int x, int y) const {
+    const size_t i = Index(x, y);
+    return {result_.depth.Values()[i], Eigen::Vector3f(&result_.normal[3 * i])};
+  }
+
+  void Initialise(int x, int y) {
+    if (!Textured(x, y)) return;  // Stays at depth 0, cost 2.
+    if (initial_ && initial_->depth.At(x, y) > 0) {
+      const size_t i = Index(x, y);
+      const Plane proposed{initial_->depth.At(x, y), Eigen::Vector3f(&initial_->normal[3 * i])};
+      if (Acceptable(x, y, proposed)) {
+        Store(x, y, proposed, Cost(x, y, proposed));
+        return;
+      }
+    }
+    const Plane random{RandomDepth(x, y, -1, 0), RandomNormal(x, y, -1, 1)};
+    Store(x, y, random, Cost(x, y, random));
+  }
+
+  void Improve(int x, int y, int iteration) {
+    if (!Textured(x, y)) return;
+    Plane best = StoredPlane(x, y);
+    float best_cost = result_.cost[Index(x, y)];
+    auto consider = [&](const Plane& candidate) {
+      // Converged neighbourhoods propose the plane this pixel already has: skip the rescoring.
+      if (std::abs(candidate.depth - best.depth) <= 1e-6f * best.depth &&
+          candidate.normal.dot(best.normal) >= 1 - 1e-7f) {
+        return;
+      }
+      if (!Acceptable(x, y, candidate)) return;
+      const float cost = Cost(x, y, candidate);
+      if (cost < best_cost) {
+        best_cost = cost;
+        best = candidate;
+      }
+    };
+    // Propagation: the neighbours' planes (of the other colour), extended to this pixel.
+    const int far = options_.far_neighbour_offset;
+    const std::array<std::pair<int, int>, 8> offsets = {
+        {{-1, 0}, {1, 0}, {0, -1}, {0, 1}, {-far, 0}, {far, 0}, {0, -far}, {0, far}}};
+    const Eigen::Vector3f ray = Ray(x, y);
+    for (int k = 0; k < (far > 0 ? 8 : 4); ++k) {
+      const int nx = x + offsets[k].first, ny = y + offsets[k].second;
+      if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
+      const Plane neighbour = StoredPlane(nx, ny);
+      if (!(neighbour.depth > 0)) continue;
+      const float rho = neighbour.depth * neighbour.normal.dot(Ray(nx, ny));
+      consider({rho / neighbour.normal.dot(ray), neighbour.normal});
+    }
+    // Random refinement, narrowing with each iteration; plus one fresh random guess.
+    const float amplitude = std::pow(0.5f, static_cast<float>(iteration + 1));
+    const float inverse = 1 / best.depth + (Random(options_.seed, x, y, iteration, 20) - 0.5f) *
+                                               amplitude * (inverse_max_ - inverse_min_);
+    if (inverse > 0) consider({1 / inverse, best.normal});
+    const Eigen::Vector3f tilted =
+        (best.normal + amplitude * RandomNormal(x, y, iteration, 30)).normalized();
+    consider({best.depth, tilted});
+    // A fresh random plane helps where nothing good has arrived yet; below the coarsest
+    // level the pyramid has already proposed one, and this is wasted work.
+    if (!initial_) consider({RandomDepth(x, y, iteration, 40), RandomNormal(x, y, iteration, 50)});
+    Store(x, y, best, best_cost);
+  }
+
+  const DepthNormalMap* initial_;
+  const PatchMatchOptions& options_;
+  WindowPattern pattern_;
+  ReferenceWindows windows_;
+  int width_, height_;
+  float inverse_min_, inverse_max_;
+  float min_cos_normal_;
+  int best_views_;
+  Eigen::Matrix3f k_ref_inverse_;
+  std::vector<SourceProjection> sources_;
+  DepthNormalMap result_;
+};
+
+StereoView HalfResolution(const StereoView& view) {
+  StereoView half;
+  half.cam_from_world = view.cam_from_world;
+  half.camera = view.camera;
+  half.image.width = view.image.width / 2;
+  half.image.height = view.image.height / 2;
+  half.camera.width = static_cast<uint64_t>(half.image.width);
+  half.camera.height = static_cast<uint64_t>(half.image.height);
+  // Pixel centres at +0.5 make the continuous coordinates scale exactly by one half.
+  const double sx = static_cast<double>(half.image.width) / view.image.width;
+  const double sy = static_cast<double>(half.image.height) / view.image.height;
+  if (half.camera.model == CameraModel::kSimplePinhole) {
+    half.camera.model = CameraModel::kPinhole;
+    half.camera.params = {view.camera.params[0], view.camera.params[0], view.camera.params[1],
+                          view.camera.params[2]};
+  }
+  half.camera.params[0] *= sx;
+  half.camera.params[1] *= sy;
+  half.camera.params[2] *= sx;
+  half.camera.params[3] *= sy;
+  half.image.values.resize(static_cast<size_t>(half.image.width) * half.image.height);
+  for (int y = 0; y < half.image.height; ++y) {
+    for (int x = 0; x < half.image.width; ++x) {
+      half.image.values[static_cast<size_t>(y) * half.image.width + x] =
+          0.25f * (view.image.At(2 * x, 2 * y) + view.image.At(2 * x + 1, 2 * y) +
+                   view.image.At(2 * x, 2 * y + 1) + view.image.At(2 * x + 1, 2 * y + 1));
+    }
+  }
+  return half;
+}
+
+// Each fine pixel takes the plane of the coarse pixel it lies in, intersected with its own
+// ray (planes are 3D: the same in every level's camera).
+DepthNormalMap UpsamplePlanes(const DepthNormalMap& coarse, const Camera& coarse_camera,
+                              const Camera& fine_camera) {
+  const int width = static_cast<int>(fine_camera.width), height = static_cast<int>(fine_camera.height);
+  DepthNormalMap fine{DepthMap(width, height), std::vector<float>(static_cast<size_t>(width) * height * 3, 0.0f),
+                      std::vector<float>(static_cast<size_t>(width) * height, kInvalidCost)};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const int cx = std::min(x / 2, coarse.depth.Width() - 1);
+      const int cy = std::min(y / 2, coarse.depth.Height() - 1);
+      const float depth = coarse.depth.At(cx, cy);
+      if (!(depth > 0)) continue;
+      const size_t ci = static_cast<size_t>(cy) * coarse.depth.Width() + cx;
+      const Eigen::Vector3d normal(coarse.normal[3 * ci], coarse.normal[3 * ci + 1], coarse.normal[3 * ci + 2]);
+      const double rho = static_cast<double>(depth) * normal.dot(*coarse_camera.Unproject({cx + 0.5, cy + 0.5}));
+      const double n_dot_ray = normal.dot(*fine_camera.Unproject({x + 0.5, y + 0.5}));
+      if (!(n_dot_ray < 0)) continue;
+      const size_t i = static_cast<size_t>(y) * width + x;
+      fine.depth.At(x, y) = static_cast<float>(rho / n_dot_ray);
+      std::copy_n(&coarse.normal[3 * ci], 3, &fine.normal[3 * i]);
+    }
+  }
+  return fine;
+}
+
+// Coarse to fine: the coarser levels find the surfaces cheaply and over long distances, the
+// finer ones refine them.
+DepthNormalMap PatchMatchLevel(const StereoView& reference,
+                               const std::vector<const StereoView*>& sources,
+                               const PatchMatchOptions& options, int levels) {
+  std::optional<DepthNormalMap> initial;
+  const int min_size = 4 * options.window_radius + 8;
+  if (levels > 1 && reference.image.width / 2 >= min_size && reference.image.height / 2 >= min_size) {
+    const StereoView coarse_reference = HalfResolution(reference);
+    std::vector<StereoView> coarse_sources;
+    coarse_sources.reserve(sources.size());
+    for (const StereoView* source : sources) coarse_sources.push_back(HalfResolution(*source));
+    std::vector<const StereoView*> coarse_pointers;
+    for (const StereoView& source : coarse_sources) coarse_pointers.push_back(&source);
+    PatchMatchOptions coarse_options = options;
+    coarse_options.max_cost = 2;  // Keep every plane as a proposal; this level scores them.
+    const DepthNormalMap coarse =
+        PatchMatchLevel(coarse_reference, coarse_pointers, coarse_options, levels - 1);
+    initial = UpsamplePlanes(coarse, coarse_reference.camera, reference.camera);
+  }
+  return PatchMatcher(reference, sources, options, initial ? &*initial : nullptr).Run();
+}
+
+}  // namespace
+
+void PatchMatchOptions::Check() const {
+  RequireOption(window_radius >= 1 && window_radius <= 15, "PatchMatchOptions.window_radius", window_radius, "[1, 15]");
+  RequireOption(window_step >= 1 && window_step <= window_radius, "PatchMatchOptions.window_step", window_step,
+                "[1, window_radius]");
+  RequireOption(iterations >= 0, "PatchMatchOptions.iterations", iterations, ">= 0");
+  RequireOption(pyramid_levels >= 1 && pyramid_levels <= 6, "PatchMatchOptions.pyramid_levels", pyramid_levels, "[1, 6]");
+  RequireOption(far_neighbour_offset >= 0 && (far_neighbour_offset % 2 == 1 || far_neighbour_offset == 0),
+                "PatchMatchOptions.far_neighbour_offset", far_neighbour_offset,
+                "0 or odd (red-black propagation)");
+  RequireOption(sigma_color > 0, "PatchMatchOptions.sigma_color", sigma_color, "> 0");
+  RequireOption(sigma_spatial_px > 0, "PatchMatchOptions.sigma_spatial_px", sigma_spatial_px, "> 0");
+  RequireOption(best_views >= 1, "PatchMatchOptions.best_views", best_views, ">= 1");
+  RequireOption(min_texture_std > 0, "PatchMatchOptions.min_texture_std", min_texture_std, "> 0");
+  RequireOption(max_cost > 0 && max_cost <= 2, "PatchMatchOptions.max_cost", max_cost, "(0, 2]");
+  RequireOption(min_depth > 0, "PatchMatchOptions.min_depth", min_depth, "> 0");
+  RequireOption(max_depth > min_depth && std::isfinite(max_depth), "PatchMatchOptions.max_depth", max_depth,
+                "finite and > min_depth");
+  RequireOption(max_normal_angle_deg > 0 && max_normal_angle_deg < 90, "PatchMatchOptions.max_normal_angle_deg",
+                max_normal_angle_deg, "(0, 90)");
+}
+
+Eigen::Matrix3d PlaneHomography(const Camera& reference, const Camera& source,
+                                const Rigid3d& source_from_reference, const Eigen::Vector3d& normal,
+                                double rho) {
+  const Eigen::Matrix3d k_ref = Intrinsics(reference);
+  return Intrinsics(source) *
+         (source_from_reference.rotation.toRotationMatrix() +
+          source_from_reference.translation * normal.transpose() / rho) *
+         k_ref.inverse();
+}
+
+float WindowCost(const GrayImage& reference, int x, int y, const GrayImage& source,
+                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options) {
+  const WindowPattern pattern(options);
+  const ReferenceWindows windows(reference, pattern, options);
+  const ReferenceWindow window = windows.At(x, y);
+  if (window.stddev < options.min_texture_std) return kInvalidCost;
+  const SourceProjection projection{&source, {}, {}, static_cast<float>(source.width - 1),
+                                    static_cast<float>(source.height - 1)};
+  return SourceCost(projection, homography.cast<float>(), static_cast<float>(x) + 0.5f,
+                    static_cast<float>(y) + 0.5f, window, pattern, options.min_texture_std);
+}
+
+double InverseDepthSample(double min_depth, double max_depth, double fraction) {
+  return 1 / (1 / max_depth + fraction * (1 / min_depth - 1 / max_depth));
+}
+
+DepthNormalMap PatchMatchStereo(const StereoView& reference,
+                                const std::vector<const StereoView*>& sources,
+                                const PatchMatchOptions& options) {
+  options.Check();
+  if (sources.empty() || sources.size() > kMaxSources) {
+    throw std::invalid_argument("PatchMatchStereo needs 1 to 16 source views, got " +
+                                std::to_string(sources.size()));
+  }
+  CheckPinhole(reference.camera, reference.image);
+  for (const StereoView* source : sources) CheckPinhole(source->camera, source->image);
+  return PatchMatchLevel(reference, sources, options, options.pyramid_levels);
+}
+
+}  // namespace parallax

@@ -1,0 +1,161 @@
+#include "pipeline/render_request.h"
+
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "core/workspace.h"
+#include "mvs/mvs.h"
+#include "pipeline/dense_stages.h"
+#include "pipeline/stage_graph.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+std::string CsvRow(const std::string& name, const NovelView& view) {
+  const HoleMetrics& m = view.result.metrics;
+  std::string sources;
+  for (const std::string& source : view.sources) sources += (sources.empty() ? "" : " ") + source;
+  const std::string fill = view.result.fill.skipped.empty() ? "ran" : "skipped: " + view.result.fill.skipped;
+  char numbers[256];
+  std::snprintf(numbers, sizeof(numbers), ",%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%d,",
+                m.hole_ratio, view.result.fill.hole_ratio_filled, m.crack_ratio,
+                m.disocclusion_ratio, m.out_of_view_ratio, m.background_ratio, m.hole_count,
+                m.largest_hole_px);
+  char ms[32];
+  std::snprintf(ms, sizeof(ms), ",%.2f\n", view.ms);
+  // Names and the fill's reason can be long: no fixed-size buffer for them.
+  return name + "," + sources + numbers + fill + ms;
+}
+
+RequestStage Ran(const std::string& name, const std::string& what) { return {name, false, what}; }
+RequestStage Skipped(const std::string& name, const std::string& why) { return {name, true, why}; }
+
+// A workspace made with `reconstruct --no-depth` (or missing some depth maps) gets depth for
+// the source views the targets use, and for no other view.
+void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& library,
+                          const std::vector<NamedCamera>& targets,
+                          const SourceSelectionOptions& selection, Progress& progress,
+                          RenderSummary& summary) {
+  std::set<std::string> missing;
+  for (const NamedCamera& target : targets) {
+    for (int index : SelectSources(library.Cameras(), target.camera, selection)) {
+      const std::string& name = library.Names()[static_cast<size_t>(index)];
+      if (!fs::exists(workspace.Depth(name))) missing.insert(name);
+    }
+  }
+  if (missing.empty()) {
+    summary.stages.push_back(Skipped("depth", "every source view these cameras use already has a depth map"));
+    return;
+  }
+  // The depth stage of the workspace's graph, for these views: recorded in stages.json like
+  // reconstruct's, at reconstruct's default quality.
+  StageGraph graph(workspace, false);
+  DepthRequest request;
+  request.views.assign(missing.begin(), missing.end());
+  MvsSummary mvs;
+  graph.Run(DepthStage(workspace, UndistortedModelKey(workspace, graph), request, progress, &mvs));
+  char note[256];
+  std::snprintf(note, sizeof(note),
+                "estimated %zu of %zu views (PatchMatch on %d, for the geometric check); the "
+                "other views are not needed by these cameras",
+                mvs.views.size(), library.Cameras().size(), mvs.estimated_views);
+  summary.depth_note = note;
+  summary.depth_estimated = request.views;
+  summary.stages.push_back(Ran("depth", "estimated for " + std::to_string(missing.size()) + " of " +
+                                            std::to_string(library.Cameras().size()) +
+                                            " views: those these cameras use and had none"));
+}
+
+RequestStage DepthHolesStage(bool scene_folder, const SourceLibrary& library,
+                             const WorkspaceDepthPreparation& depth_holes) {
+  if (scene_folder) return Skipped("depth_holes", "ground-truth depth has no holes");
+  if (library.LoadedPixels() == 0 || !depth_holes.mesh) return Skipped("depth_holes", depth_holes.note);
+  char share[32];
+  std::snprintf(share, sizeof share, "%.2f%%",
+                100.0 * static_cast<double>(library.PreparedPixels()) /
+                    static_cast<double>(library.LoadedPixels()));
+  return Ran("depth_holes", "filled " + std::string(share) + " of the loaded sources' pixels " +
+                                depth_holes.note);
+}
+
+RequestStage FillStage(const std::map<std::string, size_t>& fill_skipped, size_t views) {
+  std::string fill_skips;
+  size_t skipped_views = 0;
+  for (const auto& [reason, count] : fill_skipped) {
+    fill_skips += "; skipped for " + std::to_string(count) + ": " + reason;
+    skipped_views += count;
+  }
+  const bool none_filled = !fill_skipped.empty() && skipped_views == views;
+  const std::string ran = "ran for " + std::to_string(views - skipped_views) + " of " +
+                          std::to_string(views) + " views" + fill_skips;
+  return none_filled ? Skipped("fill", fill_skips.substr(2)) : Ran("fill", ran);
+}
+
+}  // namespace
+
+void to_json(nlohmann::json& json, const RequestStage& stage) {
+  json = {{"name", stage.name}, {"skipped", stage.skipped}, {"reason", stage.reason}};
+}
+
+RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
+                            const NovelViewSettings& settings, const fs::path& out,
+                            Progress& progress, const RenderedView& on_view) {
+  RenderSummary summary;
+  SourceLibrary library(SourcePathsFor(input));
+  const std::vector<NamedCamera> targets =
+      cameras.model.empty() ? CamerasAlongPath(cameras.path, library.Cameras(), library.Names())
+                            : CamerasFromModel(cameras.model);
+  summary.source_views = library.Cameras().size();
+  const SceneFolder scene{input};
+  const bool scene_folder = fs::is_directory(scene.GroundTruth());
+  if (scene_folder) {
+    summary.stages.push_back(Skipped("depth", "a scene folder: its ground-truth depth maps are used"));
+  } else {
+    EstimateMissingDepth(Workspace(input), library, targets, settings.selection, progress, summary);
+  }
+  // What `reconstruct` would also make, and a request for novel views alone does not need.
+  summary.stages.push_back(Skipped("fusion", "novel views warp each source's depth map; no fused cloud is needed"));
+  summary.stages.push_back(Skipped("mesh", "only novel views are requested: building the Poisson mesh and its "
+                                           "texture atlas for them would cost more than the holes it fills "
+                                           "(one that reconstruct made is used, see depth_holes)"));
+  summary.dropped = library.DropViewsWithoutDepth();
+  const WorkspaceDepthPreparation depth_holes =
+      scene_folder ? WorkspaceDepthPreparation{} : PrepareWorkspaceDepth(input, settings, &library);
+  std::string csv =
+      "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
+      "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
+  double hole_sum = 0, filled_sum = 0, ms_sum = 0;
+  std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.
+  Renderer renderer(settings.render);
+  NovelView view;
+  for (size_t i = 0; i < targets.size(); ++i) {
+    RenderNovelView(library, targets[i], settings.selection, renderer, &view);
+    WriteNovelView(out, targets[i].name, view.result);
+    csv += CsvRow(targets[i].name, view);
+    hole_sum += view.result.metrics.hole_ratio;
+    filled_sum += view.result.fill.hole_ratio_filled;
+    ms_sum += view.ms;
+    if (!view.result.fill.skipped.empty()) ++fill_skipped[view.result.fill.skipped];
+    if (on_view) on_view(i, targets.size(), targets[i], view);
+  }
+  WriteFileAtomically(out / "render.csv", csv);
+  summary.sources_loaded = library.LoadedCount();
+  summary.stages.push_back(Ran("sources", "loaded " + std::to_string(library.LoadedCount()) + " of " +
+                                              std::to_string(summary.source_views) +
+                                              " source views: the others can not contribute to these cameras"));
+  summary.stages.push_back(DepthHolesStage(scene_folder, library, depth_holes));
+  summary.stages.push_back(FillStage(fill_skipped, targets.size()));
+  WriteFileAtomically(out / "report.json",
+                      nlohmann::json({{"render", {{"stages", summary.stages}}}}).dump(2) + "\n");
+  const double n = static_cast<double>(targets.size());
+  summary.views = targets.size();
+  summary.hole_ratio_mean = hole_sum / n;
+  summary.hole_ratio_filled_mean = filled_sum / n;
+  summary.ms_per_view = ms_sum / n;
+  return summary;
+}
+
+}  // namespace parallax

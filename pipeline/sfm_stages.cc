@@ -1,0 +1,383 @@
+#include "pipeline/sfm_stages.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "colmap/database.h"
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/hash.h"
+#include "sfm/undistort.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+struct QualitySettings {
+  int max_image_size;
+  int max_num_features;
+  bool guided_matching;
+};
+
+QualitySettings SettingsFor(Quality quality) {
+  switch (quality) {
+    case Quality::kFast: return {1024, 2048, false};
+    case Quality::kBalanced: return {2000, 4096, false};
+    case Quality::kBest: return {3200, 8192, true};
+  }
+  throw std::invalid_argument("unknown quality");
+}
+
+std::string Join(const std::vector<double>& values) {
+  std::ostringstream text;
+  text.precision(17);
+  for (size_t i = 0; i < values.size(); ++i) text << (i ? "," : "") << values[i];
+  return text.str();
+}
+
+// Removes a folder left by an interrupted stage, or the previous result a stage replaces.
+void RemoveAll(const fs::path& path) {
+  std::error_code error;
+  fs::remove_all(path, error);
+  if (error) throw BadInputError("cannot remove " + path.string() + ": " + error.message());
+}
+
+// Moves `from` to `to`, replacing what was there (directory rename is atomic).
+void Replace(const fs::path& from, const fs::path& to) {
+  RemoveAll(to);
+  fs::rename(from, to);
+}
+
+// The known model rewritten with the ids COLMAP's database gave the photos, so that
+// point_triangulator can match its images and cameras to the features and matches.
+SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& photos,
+                                      const fs::path& known_dir, const fs::path& database) {
+  const std::map<std::string, DatabaseImage> ids = ReadDatabaseImages(database);
+  const bool single = known.Cameras().size() == 1;
+  SparseModel aligned;
+  for (const Photo& photo : photos.photos) {
+    const SparseImage* image = known.FindImageByName(photo.name);
+    if (!image) {
+      throw BadInputError("--known-cameras " + known_dir.string() + " has no image named " +
+                          photo.name);
+    }
+    const auto id = ids.find(photo.name);
+    if (id == ids.end()) {
+      throw BadInputError(database.string() + " has no image named " + photo.name);
+    }
+    SparseImage copy = *image;
+    copy.id = id->second.image_id;
+    copy.camera_id = id->second.camera_id;
+    copy.points2d.clear();
+    // One shared camera in the database when the known model has one (single_camera).
+    if (!(single && !aligned.Cameras().empty())) {
+      Camera camera = known.CameraById(image->camera_id);
+      camera.id = copy.camera_id;
+      aligned.AddCamera(camera);
+    }
+    aligned.AddImage(std::move(copy));
+  }
+  return aligned;
+}
+
+// A final bundle adjustment that also frees the principal point, kept only when the point
+// stays near the image centre: where it is unobservable (a narrow arc of small images) it
+// drifts far off and the rotations with it (6.6 degrees on example_images/small).
+std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
+                                 const ReconstructOptions& options, Progress& progress) {
+  const fs::path refined = paths.RefinedModelScratch();
+  RemoveAll(refined);
+  fs::create_directories(refined);
+  colmap.Run("bundle_adjuster",
+             {"--input_path", paths.RawModel().string(), "--output_path", refined.string(),
+              "--BundleAdjustment.refine_principal_point", "1"},
+             paths.Log("refine"), "refine", 0, progress);
+  const SparseModel model = ReadSparseModel(refined);
+  double worst_offset = 0;
+  for (const Camera& camera : model.Cameras()) {
+    worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
+  }
+  char note[160];
+  if (worst_offset > options.max_refined_principal_point_offset) {
+    std::snprintf(note, sizeof(note),
+                  "principal point refinement rejected: it drifted %.1f%% of the image size "
+                  "off-centre (not observable in these photos)", 100 * worst_offset);
+  } else {
+    WriteSparseModel(model, paths.RawModel(), SparseFormat::kBinary);
+    std::snprintf(note, sizeof(note),
+                  "principal point refined in a final bundle adjustment (%.1f%% off-centre)",
+                  100 * worst_offset);
+  }
+  RemoveAll(refined);
+  return note;
+}
+
+// The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
+std::vector<fs::path> ModelDirs(const Workspace& paths) {
+  const fs::path models_dir = paths.Models();
+  std::vector<fs::path> dirs;
+  for (const auto& entry : fs::directory_iterator(models_dir)) {
+    if (entry.is_directory() && DetectSparseFormat(entry.path())) dirs.push_back(entry.path());
+  }
+  if (dirs.empty()) {
+    throw BadInputError("COLMAP could not reconstruct these photos (no image pair with "
+                        "enough matches to start from); see " +
+                        paths.Log("mapper").string());
+  }
+  std::sort(dirs.begin(), dirs.end());
+  return dirs;
+}
+
+// The model with the most registered images (the first of equals).
+SparseModel LargestModel(const std::vector<fs::path>& dirs) {
+  SparseModel best;
+  for (const fs::path& dir : dirs) {
+    SparseModel model = ReadSparseModel(dir);
+    if (model.Images().size() > best.Images().size()) best = std::move(model);
+  }
+  return best;
+}
+
+}  // namespace
+
+CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
+                              const SparseModel* known) {
+  const bool shared = photos.SharesOneCamera();
+  if (known) {
+    const bool single = known->Cameras().size() == 1;
+    const Camera& first = known->Cameras().front();
+    return {single ? first.model : options.camera_model, single ? Join(first.params) : "",
+            single, true};
+  }
+  if (options.intrinsics.empty()) return {options.camera_model, "", shared, false};
+  if (!shared && options.intrinsics.size() == 1) {
+    throw BadInputError("--intrinsics f needs photos of one size (the principal point is put at "
+                        "the image centre); give fx,fy,cx,cy or photos of one size");
+  }
+  const Photo& photo = photos.photos.front();
+  if (options.intrinsics.size() == 1) {
+    return {CameraModel::kSimplePinhole,
+            Join({options.intrinsics[0], photo.width / 2.0, photo.height / 2.0}), true, true};
+  }
+  return {CameraModel::kPinhole, Join(options.intrinsics), true, true};
+}
+
+bool UseSequentialMatcher(const ReconstructOptions& options, int num_images) {
+  return options.matcher == MatcherChoice::kSequential ||
+         (options.matcher == MatcherChoice::kAuto && num_images > options.exhaustive_limit);
+}
+
+std::string DescribeMatcher(const ReconstructOptions& options, int num_images, bool sequential) {
+  std::string matcher =
+      sequential ? "sequential (overlap " + std::to_string(options.sequential_overlap) +
+                       ", first and last images matched for loop closure)"
+                 : "exhaustive (" + std::to_string(num_images) + " images, every pair)";
+  if (options.matcher == MatcherChoice::kAuto) matcher += ", chosen automatically";
+  return matcher;
+}
+
+Stage FeaturesStage(const SfmContext& sfm) {
+  const QualitySettings quality = SettingsFor(sfm.options.quality);
+  const Workspace& paths = sfm.workspace;
+  Stage stage;
+  stage.name = "features";
+  stage.key = Hasher()
+                  .Add(sfm.photos.ContentHash())
+                  .Add(CameraModelName(sfm.camera.model))
+                  .Add(sfm.camera.params)
+                  .Add(sfm.camera.single_camera)
+                  .Add(static_cast<uint64_t>(quality.max_image_size))
+                  .Add(static_cast<uint64_t>(quality.max_num_features))
+                  .Hex();
+  stage.outputs = {paths.Database()};
+  stage.run = [&sfm, quality, paths] {
+    fs::create_directories(paths.Sfm());
+    std::string list;
+    for (const Photo& photo : sfm.photos.photos) list += photo.name + "\n";
+    WriteFileAtomically(paths.ImageList(), list);
+    const fs::path database = paths.Database().string() + ".tmp";
+    RemoveAll(database);
+    std::vector<std::string> arguments = {
+        "--database_path", database.string(), "--image_path", sfm.photos_dir.string(),
+        "--image_list_path", paths.ImageList().string(),
+        "--ImageReader.camera_model", std::string(CameraModelName(sfm.camera.model)),
+        "--ImageReader.single_camera", sfm.camera.single_camera ? "1" : "0",
+        "--SiftExtraction.use_gpu", "0",
+        "--SiftExtraction.max_image_size", std::to_string(quality.max_image_size),
+        "--SiftExtraction.max_num_features", std::to_string(quality.max_num_features)};
+    if (!sfm.camera.params.empty()) {
+      arguments.insert(arguments.end(), {"--ImageReader.camera_params", sfm.camera.params});
+    }
+    sfm.colmap.Run("feature_extractor", arguments, paths.Log("features"), "features",
+                   static_cast<int>(sfm.photos.photos.size()), sfm.progress);
+    fs::rename(database, paths.Database());
+  };
+  return stage;
+}
+
+Stage MatchesStage(const SfmContext& sfm, const std::string& features_key) {
+  const QualitySettings quality = SettingsFor(sfm.options.quality);
+  const Workspace& paths = sfm.workspace;
+  Stage stage;
+  stage.name = "matches";
+  stage.key = Hasher()
+                  .Add(features_key)
+                  .Add(sfm.sequential)
+                  .Add(static_cast<uint64_t>(sfm.options.sequential_overlap))
+                  .Add(quality.guided_matching)
+                  .Hex();
+  stage.outputs = {paths.MatchedMarker()};
+  stage.run = [&sfm, quality, paths, key = stage.key] {
+    const int num_images = static_cast<int>(sfm.photos.photos.size());
+    const int overlap = sfm.options.sequential_overlap;
+    const fs::path database = paths.Database().string() + ".tmp";
+    fs::copy_file(paths.Database(), database, fs::copy_options::overwrite_existing);
+    const std::vector<std::string> common = {
+        "--database_path", database.string(), "--SiftMatching.use_gpu", "0",
+        "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"};
+    if (sfm.sequential) {
+      std::vector<std::string> arguments = common;
+      arguments.insert(arguments.end(), {"--SequentialMatching.overlap", std::to_string(overlap),
+                                         "--SequentialMatching.loop_detection", "0"});
+      sfm.colmap.Run("sequential_matcher", arguments, paths.Log("matches"), "matches", num_images,
+                     sfm.progress);
+      // Without a vocabulary tree, a ring closes only if its ends are matched explicitly.
+      std::string pairs;
+      const int ends = std::min(overlap / 2 + 1, num_images / 2);
+      for (int i = 0; i < ends; ++i) {
+        for (int j = num_images - ends; j < num_images; ++j) {
+          pairs += sfm.photos.photos[static_cast<size_t>(i)].name + " " +
+                   sfm.photos.photos[static_cast<size_t>(j)].name + "\n";
+        }
+      }
+      WriteFileAtomically(paths.LoopPairs(), pairs);
+      arguments = common;
+      arguments.insert(arguments.end(), {"--match_list_path", paths.LoopPairs().string(),
+                                         "--match_type", "pairs"});
+      sfm.colmap.Run("matches_importer", arguments, paths.Log("matches"), "loop closure",
+                     num_images, sfm.progress);
+    } else {
+      sfm.colmap.Run("exhaustive_matcher", common, paths.Log("matches"), "matches", num_images,
+                     sfm.progress);
+    }
+    fs::rename(database, paths.Database());
+    WriteFileAtomically(paths.MatchedMarker(), key);
+  };
+  return stage;
+}
+
+Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
+                  std::vector<std::string>& notes) {
+  const Workspace& paths = sfm.workspace;
+  const int num_images = static_cast<int>(sfm.photos.photos.size());
+  const bool refine_principal_point =
+      sfm.camera.single_camera && !sfm.camera.fixed_intrinsics &&
+      num_images >= sfm.options.refine_principal_point_min_images;
+  Stage stage;
+  stage.name = sfm.known ? "triangulate" : "mapper";
+  stage.key = Hasher()
+                  .Add(matches_key)
+                  .Add(sfm.camera.fixed_intrinsics)
+                  .Add(refine_principal_point)
+                  .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0)
+                  .Hex();
+  stage.outputs = {paths.RawModel()};
+  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, name = stage.name] {
+    const fs::path models = paths.Models().string() + ".tmp";
+    RemoveAll(models);
+    fs::create_directories(models);
+    const std::vector<std::string> common = {"--database_path", paths.Database().string(),
+                                             "--image_path", sfm.photos_dir.string()};
+    const std::vector<std::string> fixed_intrinsics = {"--Mapper.ba_refine_focal_length", "0",
+                                                       "--Mapper.ba_refine_principal_point", "0",
+                                                       "--Mapper.ba_refine_extra_params", "0"};
+    std::vector<std::string> arguments = common;
+    if (sfm.known) {
+      WriteSparseModel(AlignKnownModelToDatabase(*sfm.known, sfm.photos, sfm.options.known_cameras,
+                                                 paths.Database()),
+                       paths.KnownModel(), SparseFormat::kBinary);
+      fs::create_directories(models / "0");
+      arguments.insert(arguments.end(), {"--input_path", paths.KnownModel().string(),
+                                         "--output_path", (models / "0").string()});
+      arguments.insert(arguments.end(), fixed_intrinsics.begin(), fixed_intrinsics.end());
+      sfm.colmap.Run("point_triangulator", arguments, paths.Log(name), name, num_images,
+                     sfm.progress);
+    } else {
+      arguments.insert(arguments.end(), {"--output_path", models.string(), "--image_list_path",
+                                         paths.ImageList().string()});
+      if (sfm.camera.fixed_intrinsics) {
+        arguments.insert(arguments.end(), fixed_intrinsics.begin(), fixed_intrinsics.end());
+      }
+      sfm.colmap.Run("mapper", arguments, paths.Log(name), name, num_images, sfm.progress);
+    }
+    Replace(models, paths.Models());
+    WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);
+    if (refine_principal_point) {
+      notes.push_back(RefinePrincipalPoint(sfm.colmap, paths, sfm.options, sfm.progress));
+    }
+  };
+  return stage;
+}
+
+Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
+                     const SparseModel* raw_model) {
+  const Workspace& paths = sfm.workspace;
+  // "undistort-2": our own resampling replaced image_undistorter's for supported models;
+  // models without distortion parameters copy the photos as before, and keep their key (and
+  // depth).
+  const bool may_distort = sfm.camera.model != CameraModel::kPinhole &&
+                           sfm.camera.model != CameraModel::kSimplePinhole;
+  Hasher hasher;
+  hasher.Add(mapper_key);
+  if (may_distort) hasher.Add("undistort-2");
+  Stage stage;
+  stage.name = "undistort";
+  stage.key = hasher.Hex();
+  stage.outputs = {paths.Sparse()};
+  if (!raw_model) {
+    stage.run = [] {};
+    return stage;
+  }
+  // Cameras without distortion need no resampling: the photos are copied as they are. Models
+  // whose projection core implements are resampled by WritePinholeWorkspace; COLMAP's
+  // undistorter is left for the others (fisheye models).
+  const auto all_cameras = [raw_model](const std::function<bool(const Camera&)>& test) {
+    return std::all_of(raw_model->Cameras().begin(), raw_model->Cameras().end(), test);
+  };
+  const bool distortion_free = all_cameras([](const Camera& c) { return !c.HasDistortion(); });
+  const bool supported = all_cameras([](const Camera& c) { return IsProjectionSupported(c.model); });
+  if (distortion_free) {
+    stage.not_needed = "the cameras have no lens distortion: photos copied, not resampled "
+                       "(colmap image_undistorter not needed)";
+  }
+  stage.run = [&sfm, raw_model, paths, supported] {
+    const fs::path output = paths.UndistortScratch();
+    RemoveAll(output);
+    if (supported) {
+      WritePinholeWorkspace(*raw_model, sfm.photos_dir, output);
+    } else {
+      sfm.colmap.Run("image_undistorter",
+                     {"--image_path", sfm.photos_dir.string(), "--input_path",
+                      paths.RawModel().string(), "--output_path", output.string(),
+                      "--output_type", "COLMAP"},
+                     paths.Log("undistort"), "undistort",
+                     static_cast<int>(sfm.photos.photos.size()), sfm.progress);
+    }
+    const Workspace undistorted(output);
+    Replace(undistorted.Images(), paths.Images());
+    Replace(undistorted.Stereo(), paths.Stereo());
+    Replace(undistorted.Sparse(), paths.Sparse());
+    RemoveAll(output);
+  };
+  return stage;
+}
+
+int OtherModelCount(const Workspace& workspace) {
+  // Counting the folders is enough here: the largest model was chosen when mapping.
+  return static_cast<int>(ModelDirs(workspace).size()) - 1;
+}
+
+}  // namespace parallax

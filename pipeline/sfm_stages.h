@@ -1,0 +1,64 @@
+#pragma once
+// The structure-from-motion stages of `reconstruct` as data (pipeline/stage_graph.h):
+// features, matches, mapper (or triangulate, with known cameras) and undistort, each keyed by
+// the one before it.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "colmap/runner.h"
+#include "core/progress.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "pipeline/reconstruct.h"
+#include "pipeline/stage_graph.h"
+#include "sfm/photo_set.h"
+
+namespace parallax {
+
+// The COLMAP image model the extractor starts from, and its parameters when they are fixed.
+struct CameraSetup {
+  CameraModel model;
+  std::string params;  // Empty: COLMAP estimates them, from EXIF or the image size.
+  bool single_camera;
+  bool fixed_intrinsics;
+};
+
+// The camera model and intrinsics SfM starts from: the known model's, the given intrinsics
+// (fixed), or `options.camera_model` estimated. Throws BadInputError for --intrinsics f on
+// photos of different sizes.
+CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
+                              const SparseModel* known);
+
+// What every SfM stage reads.
+struct SfmContext {
+  std::filesystem::path photos_dir;
+  const PhotoSet& photos;
+  const SparseModel* known;  // --known-cameras, or null.
+  const ReconstructOptions& options;
+  const Colmap& colmap;
+  Workspace workspace;
+  CameraSetup camera;
+  bool sequential;  // Sequential matching (with loop closure) instead of exhaustive.
+  Progress& progress;
+};
+
+// Whether the matcher is sequential, and the sentence report.json gives for the choice.
+bool UseSequentialMatcher(const ReconstructOptions& options, int num_images);
+std::string DescribeMatcher(const ReconstructOptions& options, int num_images, bool sequential);
+
+Stage FeaturesStage(const SfmContext& sfm);
+Stage MatchesStage(const SfmContext& sfm, const std::string& features_key);
+// Notes the mapper's decisions (a principal-point refinement kept or rejected) in `notes`.
+Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
+                  std::vector<std::string>& notes);
+// Undistortion into the workspace layout (PINHOLE photos and model). `raw_model` is the
+// mapper's model, or null in a dry run (the stage is then only planned).
+Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
+                     const SparseModel* raw_model);
+
+// The mapper's models besides the largest (the one kept). Throws BadInputError when the
+// mapper made none.
+int OtherModelCount(const Workspace& workspace);
+
+}  // namespace parallax

@@ -1,0 +1,102 @@
+#include "sfm/photo_set.h"
+
+#include <algorithm>
+
+#include <OpenImageIO/imageio.h>
+#include <tbb/parallel_for.h>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/hash.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+// COLMAP's default focal length when nothing better is known.
+constexpr double kDefaultFocalFactor = 1.2;
+
+// Decodes the whole file: a truncated image often has an intact header.
+std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
+  std::string bytes;
+  try {
+    bytes = ReadFileBytes(path);
+  } catch (const BadInputError& error) {
+    return "cannot be read";
+  }
+  if (bytes.empty()) return "is empty (0 bytes)";
+  photo.content_hash = Hasher().Add(bytes).Value();
+  auto input = OIIO::ImageInput::open(path.string());
+  if (!input) return "is not an image OpenImageIO can read";
+  const OIIO::ImageSpec& spec = input->spec();
+  photo.width = spec.width;
+  photo.height = spec.height;
+  if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
+  const float focal_35mm = spec.get_float_attribute("Exif:FocalLengthIn35mmFilm", 0.0f);
+  if (focal_35mm > 0) {
+    photo.exif_focal_px = static_cast<double>(focal_35mm) / 36.0 * std::max(spec.width, spec.height);
+  }
+  std::vector<unsigned char> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
+  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data())) {
+    return "is corrupt or truncated (" + input->geterror() + ")";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool PhotoSet::SharesOneCamera() const {
+  return std::all_of(photos.begin(), photos.end(), [&](const Photo& photo) {
+    return photo.width == photos.front().width &&
+           photo.height == photos.front().height &&
+           photo.exif_focal_px == photos.front().exif_focal_px;
+  });
+}
+
+double PhotoSet::FocalPrior(const Photo& photo) const {
+  return photo.exif_focal_px.value_or(kDefaultFocalFactor * std::max(photo.width, photo.height));
+}
+
+uint64_t PhotoSet::ContentHash() const {
+  Hasher hasher;
+  for (const Photo& photo : photos) hasher.Add(photo.name).Add(photo.content_hash);
+  return hasher.Value();
+}
+
+PhotoSet ScanPhotos(const fs::path& dir) {
+  if (!fs::exists(dir)) throw BadInputError("photo folder " + dir.string() + " does not exist");
+  if (!fs::is_directory(dir)) throw BadInputError(dir.string() + " is not a folder");
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(".") || entry.is_directory()) continue;
+    names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  if (names.empty()) throw BadInputError("photo folder " + dir.string() + " is empty");
+
+  std::vector<Photo> candidates(names.size());
+  std::vector<std::optional<std::string>> problems(names.size());
+  tbb::parallel_for(size_t{0}, names.size(), [&](size_t i) {
+    candidates[i].name = names[i];
+    problems[i] = CheckPhoto(dir / names[i], candidates[i]);
+  });
+  PhotoSet set;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (problems[i]) {
+      set.skipped.push_back({names[i], *problems[i]});
+    } else {
+      set.photos.push_back(std::move(candidates[i]));
+    }
+  }
+  if (set.photos.size() < 2) {
+    std::string message = "photo folder " + dir.string() + " has " +
+                          std::to_string(set.photos.size()) +
+                          " readable image(s); structure from motion needs at least 2";
+    for (const SkippedFile& file : set.skipped) message += "\n  " + file.name + " " + file.reason;
+    throw BadInputError(message);
+  }
+  return set;
+}
+
+}  // namespace parallax

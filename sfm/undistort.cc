@@ -1,0 +1,92 @@
+#include "sfm/undistort.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+
+namespace parallax {
+
+Camera PinholeOf(const Camera& camera) {
+  return MakePinholeCamera(camera.id, camera.width, camera.height, camera.FocalX(),
+                           camera.FocalY(), camera.PrincipalX(), camera.PrincipalY());
+}
+
+void UndistortPhoto(const Camera& camera, const std::filesystem::path& input,
+                    const std::filesystem::path& output) {
+  if (!IsProjectionSupported(camera.model)) {
+    throw std::invalid_argument("UndistortPhoto: camera " + std::to_string(camera.id) +
+                                ": projection not supported for its model");
+  }
+  // Unchanged: keeps 16-bit and alpha, and does not apply EXIF orientation (COLMAP does not).
+  const cv::Mat photo = cv::imread(input.string(), cv::IMREAD_UNCHANGED);
+  if (photo.empty()) throw BadInputError(input.string() + ": cannot read the image");
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  if (photo.cols != width || photo.rows != height) {
+    throw std::invalid_argument(input.string() + ": " + std::to_string(photo.cols) + "x" +
+                                std::to_string(photo.rows) + " pixels, camera " +
+                                std::to_string(width) + "x" + std::to_string(height));
+  }
+  const double fx = camera.FocalX(), fy = camera.FocalY();
+  const double cx = camera.PrincipalX(), cy = camera.PrincipalY();
+  // Where each undistorted pixel centre lies in the photo. COLMAP puts pixel centres at
+  // integer + 0.5, OpenCV's remap at integers.
+  cv::Mat map_x(height, width, CV_32F), map_y(height, width, CV_32F);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const Eigen::Vector2d distorted =
+          camera.Distort(Eigen::Vector2d((x + 0.5 - cx) / fx, (y + 0.5 - cy) / fy));
+      map_x.at<float>(y, x) = static_cast<float>(fx * distorted.x() + cx - 0.5);
+      map_y.at<float>(y, x) = static_cast<float>(fy * distorted.y() + cy - 0.5);
+    }
+  }
+  cv::Mat undistorted;
+  cv::remap(photo, undistorted, map_x, map_y, cv::INTER_LANCZOS4, cv::BORDER_REPLICATE);
+  std::vector<int> parameters;
+  const std::string extension = output.extension().string();
+  if (extension == ".jpg" || extension == ".jpeg" || extension == ".JPG" || extension == ".JPEG") {
+    parameters = {cv::IMWRITE_JPEG_QUALITY, 100};
+  }
+  if (!cv::imwrite(output.string(), undistorted, parameters)) {
+    throw BadInputError(output.string() + ": cannot write the undistorted image");
+  }
+}
+
+void WritePinholeWorkspace(const SparseModel& model, const std::filesystem::path& photos_dir,
+                           const std::filesystem::path& output) {
+  namespace fs = std::filesystem;
+  const Workspace out(output);
+  fs::create_directories(out.Images());
+  fs::create_directories(out.StereoDepthMaps());
+  fs::create_directories(out.StereoNormalMaps());
+  fs::create_directories(out.StereoConsistencyGraphs());
+  SparseModel pinhole;
+  for (const Camera& camera : model.Cameras()) pinhole.AddCamera(PinholeOf(camera));
+  std::string patch_match, fusion;
+  for (const SparseImage& image : model.Images()) {
+    pinhole.AddImage(image);
+    fs::create_directories(out.Image(image.name).parent_path());
+    const Camera& camera = model.CameraById(image.camera_id);
+    if (camera.HasDistortion()) {
+      UndistortPhoto(camera, photos_dir / image.name, out.Image(image.name));
+    } else {
+      fs::copy_file(photos_dir / image.name, out.Image(image.name),
+                    fs::copy_options::overwrite_existing);
+    }
+    patch_match += image.name + "\n__auto__, 20\n";
+    fusion += image.name + "\n";
+  }
+  for (const Point3D& point : model.Points3D()) pinhole.AddPoint3D(point);
+  WriteSparseModel(pinhole, out.Sparse(), SparseFormat::kBinary);
+  WriteFileAtomically(out.StereoConfig("patch-match.cfg"), patch_match);
+  WriteFileAtomically(out.StereoConfig("fusion.cfg"), fusion);
+}
+
+}  // namespace parallax

@@ -1,0 +1,157 @@
+// Texturing a mesh from photos, its files, and the PLY mesh reader, on analytic inputs.
+#include "mesh/texture.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "eval/mesh_evaluation.h"
+#include "geometry/ply.h"
+#include "geometry/textured_mesh.h"
+#include "tests/temp_dir.h"
+
+namespace parallax {
+namespace {
+
+// Linear colour painted on the plane z = 5, smooth enough to be resampled.
+Eigen::Vector3f Paint(double x, double y) {
+  return Eigen::Vector3f(static_cast<float>(0.5 + 0.4 * std::sin(3 * x)),
+                         static_cast<float>(0.5 + 0.4 * std::cos(2 * y)),
+                         static_cast<float>(0.3 + 0.2 * std::sin(x + y)));
+}
+
+constexpr double kPlaneDepth = 5;
+
+// A camera at the origin looking down +z at the painted plane, and its photo.
+TextureView PlaneView() {
+  TextureView view;
+  view.camera = MakePinholeCamera(1, 96, 72, 80, 80, 48, 36);
+  view.colour = Image(96, 72, 3);
+  for (int y = 0; y < 72; ++y) {
+    for (int x = 0; x < 96; ++x) {
+      const Eigen::Vector3f colour =
+          Paint((x + 0.5 - 48) / 80 * kPlaneDepth, (y + 0.5 - 36) / 80 * kPlaneDepth);
+      for (int c = 0; c < 3; ++c) view.colour.At(x, y, c) = colour[c];
+    }
+  }
+  return view;
+}
+
+// A grid of quads on the plane, wider than the view.
+PlyMesh PlaneMesh(int cells) {
+  PlyMesh mesh;
+  const double half = 4;
+  for (int j = 0; j <= cells; ++j) {
+    for (int i = 0; i <= cells; ++i) {
+      mesh.vertices.emplace_back(static_cast<float>(-half + 2 * half * i / cells),
+                                 static_cast<float>(-half + 2 * half * j / cells),
+                                 static_cast<float>(kPlaneDepth));
+    }
+  }
+  for (int j = 0; j < cells; ++j) {
+    for (int i = 0; i < cells; ++i) {
+      const int a = j * (cells + 1) + i, b = a + 1, c = a + cells + 1, d = c + 1;
+      mesh.triangles.emplace_back(a, b, c);
+      mesh.triangles.emplace_back(b, d, c);
+    }
+  }
+  return mesh;
+}
+
+TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
+  const TextureView view = PlaneView();
+  const PlyMesh plane = PlaneMesh(40);
+  TextureSummary summary;
+  const TexturedMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
+  // Triangles outside the view stay untextured; the ones inside are ~2.6 px large.
+  EXPECT_GT(summary.untextured_triangles, 0u);
+  EXPECT_LT(summary.untextured_triangles, plane.triangles.size());
+  EXPECT_GE(summary.texels_per_edge, 2);
+
+  std::vector<uint8_t> covered;
+  const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
+  const Image render =
+      RenderTexturedMesh(mesh, raycaster, view.camera, view.cam_from_world, covered);
+  double squared = 0;
+  int pixels = 0;
+  for (int y = 0; y < 72; ++y) {
+    for (int x = 0; x < 96; ++x) {
+      ASSERT_TRUE(covered[static_cast<size_t>(y * 96 + x)]);
+      for (int c = 0; c < 3; ++c) {
+        const double d = render.At(x, y, c) - LinearToSrgb(view.colour.At(x, y, c));
+        squared += d * d;
+      }
+      ++pixels;
+    }
+  }
+  const double psnr = -10 * std::log10(squared / (3.0 * pixels));
+  EXPECT_GT(psnr, 35) << "a plane seen head-on is textured almost losslessly";
+}
+
+TEST(Texture, TexturedMeshFilesRoundTrip) {
+  const TempDir dir;
+  const TextureView view = PlaneView();
+  const PlyMesh plane = PlaneMesh(4);
+  TextureSummary summary;
+  const TexturedMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
+  WriteTexturedMesh(Workspace(dir.Path()).MeshDir(), mesh);
+  EXPECT_FALSE(std::filesystem::exists(dir.Path() / "mesh.tmp"));
+  const TexturedMesh read = ReadTexturedMesh(Workspace(dir.Path()).Mesh());
+  ASSERT_EQ(read.triangles.size(), mesh.triangles.size());
+  ASSERT_EQ(read.corner_uvs.size(), mesh.corner_uvs.size());
+  for (size_t i = 0; i < mesh.corner_uvs.size(); ++i) {
+    EXPECT_LT((read.corner_uvs[i] - mesh.corner_uvs[i]).norm(), 1e-6f);
+  }
+  for (size_t i = 0; i < mesh.vertices.size(); ++i) {
+    EXPECT_LT((read.vertices[i] - mesh.vertices[i]).norm(), 1e-5f);
+  }
+  EXPECT_EQ(read.atlas.Width(), mesh.atlas.Width());
+  // The atlas went through 8-bit PNG.
+  EXPECT_NEAR(read.atlas.At(3, 3, 1), mesh.atlas.At(3, 3, 1), 0.5f / 255 + 1e-6f);
+}
+
+TEST(Texture, MalformedObjNamesFileAndLine) {
+  const TempDir dir;
+  std::ofstream(dir.Path() / "bad.obj") << "mtllib m.mtl\nv 0 0 0\nvt 0 0\nf 1/1 2/1 1/1\n";
+  try {
+    ReadTexturedMesh(dir.Path() / "bad.obj");
+    FAIL() << "no error";
+  } catch (const BadInputError& error) {
+    EXPECT_NE(std::string(error.what()).find("bad.obj:4"), std::string::npos) << error.what();
+  }
+}
+
+TEST(Ply, ReadsMeshesAndRejectsIndicesOutOfRange) {
+  const TempDir dir;
+  auto write = [&](int index) {
+    std::ofstream file(dir.Path() / "m.ply", std::ios::binary);
+    file << "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+            "property float y\nproperty float z\nproperty uchar red\nelement face 1\n"
+            "property list uchar int vertex_indices\nend_header\n";
+    for (int v = 0; v < 3; ++v) {
+      const float xyz[3] = {static_cast<float>(v), 1.0f, 2.0f};
+      file.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+      file.put('\x7f');
+    }
+    file.put('\x03');
+    const int indices[3] = {0, 1, index};
+    file.write(reinterpret_cast<const char*>(indices), sizeof(indices));
+  };
+  write(2);
+  const PlyMesh mesh = ReadPly(dir.Path() / "m.ply");
+  ASSERT_EQ(mesh.vertices.size(), 3u);
+  ASSERT_EQ(mesh.triangles.size(), 1u);
+  EXPECT_EQ(mesh.triangles[0], Eigen::Vector3i(0, 1, 2));
+  EXPECT_EQ(mesh.vertices[2], Eigen::Vector3f(2, 1, 2));
+  write(3);
+  EXPECT_THROW(ReadPly(dir.Path() / "m.ply"), BadInputError);
+  write(-1);
+  EXPECT_THROW(ReadPly(dir.Path() / "m.ply"), BadInputError);
+}
+
+}  // namespace
+}  // namespace parallax

@@ -1,0 +1,2 @@
+# Tests over ~30 s get the `slow` label besides their module's, for `ctest -LE slow`.
+set_tests_properties(${bench_test_TESTS} PROPERTIES LABELS "bench;slow")
