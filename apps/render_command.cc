@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "apps/commands.h"
@@ -50,7 +51,10 @@ void RegisterRenderCommand(CLI::App& app) {
     RenderSummary summary;
     {
       TerminalProgress progress;
-      summary = RenderCameras(arguments->input, {arguments->cameras, arguments->path},
+      const RenderTargets targets{arguments->cameras, arguments->path.empty()
+                                                          ? std::nullopt
+                                                          : std::optional(ParseCameraPath(arguments->path))};
+      summary = RenderCameras(arguments->input, targets,
                               arguments->settings, arguments->out,
                               progress, print_view);
     }

@@ -38,25 +38,6 @@ struct ViewArguments {
   bool shadow_iou = false;  // Compare the screenshot's shadows with Embree ray tracing.
 };
 
-std::vector<double> ParseNumbers(const std::string& text, size_t count, const std::string& option) {
-  std::vector<double> values = ParseNumberList(text, option);
-  if (values.size() != count) {
-    throw std::invalid_argument(option + " " + text + ": expected " + std::to_string(count) +
-                                " comma-separated numbers");
-  }
-  return values;
-}
-
-std::pair<int, int> ParseSize(const std::string& text) {
-  int width = 0, height = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &width, &x, &height, &extra) != 3 || x != 'x' || width < 16 ||
-      height < 16 || width > 16384 || height > 16384) {
-    throw std::invalid_argument("--size " + text + ": expected WxH with 16..16384 pixels per side, e.g. 1280x720");
-  }
-  return {width, height};
-}
-
 FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
   FrameSettings settings = a.settings;
   settings.shadows = a.shadows;

@@ -8,7 +8,7 @@
 namespace parallax {
 namespace fs = std::filesystem;
 
-Image RenderTexturedMesh(const TexturedMesh& mesh, const MeshRaycaster& raycaster,
+Image RenderTexturedMesh(const TriangleMesh& mesh, const MeshRaycaster& raycaster,
                          const Camera& camera, const Rigid3d& cam_from_world,
                          std::vector<uint8_t>& covered) {
   const std::vector<RayHit> hits = raycaster.CastPixels(camera, cam_from_world);
@@ -30,7 +30,7 @@ Image RenderTexturedMesh(const TexturedMesh& mesh, const MeshRaycaster& raycaste
   return render;
 }
 
-TexturedMeshScore ScoreTexturedMesh(const TexturedMesh& mesh, const SparseModel& model,
+TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model,
                                     const fs::path& images_dir, const fs::path& render_dir) {
   TexturedMeshScore score;
   if (!render_dir.empty()) fs::create_directories(render_dir);

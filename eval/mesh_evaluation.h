@@ -5,7 +5,7 @@
 
 #include "core/sparse_model.h"
 #include "geometry/raycaster.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 
 namespace parallax {
 
@@ -18,13 +18,13 @@ struct TexturedMeshScore {
 // Renders `mesh` from every image of `model` (distortion-free cameras) and compares with
 // `images_dir`/<name>. With a non-empty `render_dir`, writes each render there as
 // <stem>.png (uncovered pixels black) to look at.
-TexturedMeshScore ScoreTexturedMesh(const TexturedMesh& mesh, const SparseModel& model,
+TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model,
                                     const std::filesystem::path& images_dir,
                                     const std::filesystem::path& render_dir);
 
 // The textured mesh seen from a camera: sRGB colour where covered, `covered` set there.
 // `raycaster` holds `mesh`'s triangles (built once, shared by all views).
-Image RenderTexturedMesh(const TexturedMesh& mesh, const MeshRaycaster& raycaster,
+Image RenderTexturedMesh(const TriangleMesh& mesh, const MeshRaycaster& raycaster,
                          const Camera& camera, const Rigid3d& cam_from_world,
                          std::vector<uint8_t>& covered);
 

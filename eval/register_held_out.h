@@ -22,12 +22,12 @@ struct HeldOutRegistration {
 // adds the photos without moving the training cameras (the depth maps stay valid). The photos'
 // pixels give their poses only; nothing is rendered from them. Aligning ground-truth poses
 // with a similarity instead carries the reconstruction's local pose errors into the
-// novel cameras (up to a pixel on the courtyard). Work and logs go to `work_dir`; a second
+// novel cameras. Work and logs go to `work_dir`; a second
 // call with the same photos (names and bytes), the same model and database size reuses the
 // result. Returns an empty map and the reason when the workspace has no database (e.g. made
 // from known cameras), a name is also one in the database, or COLMAP fails. The rendered
 // targets keep their own (ground-truth) intrinsics: the registration solves the pose with the
-// workspace's estimated camera, whose focal length matches to 2e-6 on the courtyard.
+// workspace's estimated camera.
 HeldOutRegistration RegisterHeldOutPhotos(const std::filesystem::path& workspace,
                                           const std::filesystem::path& images_dir,
                                           const std::vector<std::string>& names,

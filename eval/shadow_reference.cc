@@ -9,7 +9,7 @@
 
 namespace parallax {
 
-std::vector<ReferencePixel> ReferenceShadows(const TexturedMesh& mesh, const ViewCamera& view,
+std::vector<ReferencePixel> ReferenceShadows(const TriangleMesh& mesh, const ViewCamera& view,
                                              const Eigen::Vector3d& direction) {
   if (!(direction.norm() > 0) || !direction.allFinite()) {
     throw std::invalid_argument("ReferenceShadows: the light direction must be finite and non-zero");
@@ -97,7 +97,7 @@ MaskComparison CompareCastShadows(const std::vector<ReferencePixel>& reference, 
       [](const ReferencePixel& pixel) { return !pixel.facing_away; });
 }
 
-ShadowAccuracy MeasureShadowAccuracy(const TexturedMesh& drawn, const ViewCamera& view,
+ShadowAccuracy MeasureShadowAccuracy(const TriangleMesh& drawn, const ViewCamera& view,
                                      const FrameSettings& settings, const FrameResult& frame) {
   if (settings.light.type != LightKind::kDirectional || drawn.triangles.empty()) {
     throw BadInputError("--shadow-iou needs a directional light and a mesh");

@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 
 #include "core/image.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "viewer/renderer.h"
 
 namespace parallax {
@@ -25,7 +25,7 @@ struct ReferencePixel {
 // Per pixel of `view` (row-major): the surface of `mesh` its centre ray hits and whether a
 // directional light travelling along `direction` reaches it. Faces are lit on the side the eye
 // sees (reconstructed meshes have no consistent winding).
-std::vector<ReferencePixel> ReferenceShadows(const TexturedMesh& mesh, const ViewCamera& view,
+std::vector<ReferencePixel> ReferenceShadows(const TriangleMesh& mesh, const ViewCamera& view,
                                              const Eigen::Vector3d& direction);
 
 // The renderer's masks, from FrameResult::aux: a surface facing away from the light or not lit
@@ -58,7 +58,7 @@ struct ShadowAccuracy {
 
 // A rendered frame's shadow mask against Embree's exact one for the mesh it drew. Throws
 // BadInputError without a directional light or a mesh.
-ShadowAccuracy MeasureShadowAccuracy(const TexturedMesh& drawn, const ViewCamera& view,
+ShadowAccuracy MeasureShadowAccuracy(const TriangleMesh& drawn, const ViewCamera& view,
                                      const FrameSettings& settings, const FrameResult& frame);
 
 }  // namespace parallax

@@ -5,7 +5,7 @@
 #include "core/sparse_model.h"
 #include "eval/register_held_out.h"
 #include "geometry/ply.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -39,7 +39,7 @@ std::optional<std::map<std::string, double>> ReconstructTimings(const Workspace&
 MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estimate,
                             const SparseModel& truth, const SceneFolder& scene,
                             const Similarity3d& truth_from_estimate) {
-  const TexturedMesh mesh = ReadTexturedMesh(workspace.Mesh());
+  const TriangleMesh mesh = ReadTexturedMesh(workspace.Mesh());
   MeshEvaluation result;
   result.triangles = mesh.triangles.size();
   result.vertices = mesh.vertices.size();

@@ -12,7 +12,7 @@
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "geometry/ply.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "synth/scene.h"
 
 namespace parallax::fuzz {

@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -106,8 +107,27 @@ int64_t LoadInteger(const std::string& type, const char* data) {
   return -1;  // Floating-point list types are not indices.
 }
 
+// The byte offset in a record of the three consecutive properties `type` a, b, c; nullopt
+// when the element does not have them so.
+std::optional<size_t> TripleOffset(const Element& element, const std::string& type,
+                                   const std::array<std::string, 3>& names) {
+  size_t offset = 0;
+  for (size_t i = 0; i < element.properties.size(); ++i) {
+    if (element.properties[i] == type + " " + names[0] && i + 2 < element.properties.size() &&
+        element.properties[i + 1] == type + " " + names[1] &&
+        element.properties[i + 2] == type + " " + names[2]) {
+      return offset;
+    }
+    std::istringstream words(element.properties[i]);
+    std::string property_type;
+    words >> property_type;
+    offset += TypeSize(property_type);
+  }
+  return std::nullopt;
+}
+
 void ReadVertices(const std::string& bytes, const Element& element, size_t& offset,
-                  const fs::path& path, PlyMesh& mesh) {
+                  const fs::path& path, TriangleMesh& mesh) {
   if (element.properties.size() < 3 || element.properties[0] != "float x" ||
       element.properties[1] != "float y" || element.properties[2] != "float z") {
     throw BadInputError(path.string() + ": vertices must start with float x, y, z");
@@ -116,9 +136,16 @@ void ReadVertices(const std::string& bytes, const Element& element, size_t& offs
     throw BadInputError(path.string() + ": " + std::to_string(element.count) +
                         " vertices announced, the file is shorter");
   }
+  const std::optional<size_t> normal = TripleOffset(element, "float", {"nx", "ny", "nz"});
+  const std::optional<size_t> colour = TripleOffset(element, "uchar", {"red", "green", "blue"});
   mesh.vertices.resize(element.count);
+  if (normal) mesh.normals.resize(element.count);
+  if (colour) mesh.colours.resize(element.count);
   for (size_t i = 0; i < element.count; ++i) {
-    std::memcpy(mesh.vertices[i].data(), bytes.data() + offset + i * element.stride, 12);
+    const char* record = bytes.data() + offset + i * element.stride;
+    std::memcpy(mesh.vertices[i].data(), record, 12);
+    if (normal) std::memcpy(mesh.normals[i].data(), record + *normal, 12);
+    if (colour) std::memcpy(mesh.colours[i].data(), record + *colour, 3);
     if (!mesh.vertices[i].allFinite()) {
       throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }
@@ -127,7 +154,7 @@ void ReadVertices(const std::string& bytes, const Element& element, size_t& offs
 }
 
 void ReadFaces(const std::string& bytes, const Element& element, size_t& offset,
-               const fs::path& path, PlyMesh& mesh) {
+               const fs::path& path, TriangleMesh& mesh) {
   std::istringstream list(element.properties.size() == 1 ? element.properties[0] : "");
   std::string keyword, count_type, index_type, name;
   list >> keyword >> count_type >> index_type >> name;
@@ -163,10 +190,10 @@ void ReadFaces(const std::string& bytes, const Element& element, size_t& offset,
 
 }  // namespace
 
-PlyMesh ReadPly(const fs::path& path) {
+TriangleMesh ReadPly(const fs::path& path) {
   const std::string bytes = ReadFileBytes(path);
   const Header header = ParseHeader(bytes, path);
-  PlyMesh mesh;
+  TriangleMesh mesh;
   size_t offset = header.body;
   bool has_vertices = false;
   for (const Element& element : header.elements) {

@@ -4,58 +4,25 @@
 #include <stdexcept>
 #include <string>
 
-#include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "geometry/embree_scene.h"
 
 namespace parallax {
 
 struct MeshRaycaster::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::string error;
+  EmbreeScene embree;
 };
 
 MeshRaycaster::MeshRaycaster(const std::vector<Eigen::Vector3f>& vertices,
                              const std::vector<Eigen::Vector3i>& triangles)
     : impl_(std::make_unique<Impl>()) {
-  impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
-  rtcSetDeviceErrorFunction(
-      impl_->device,
-      [](void* user, RTCError, const char* message) {
-        static_cast<Impl*>(user)->error = message ? message : "unknown error";
-      },
-      impl_.get());
-  impl_->scene = rtcNewScene(impl_->device);
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-  if (!triangles.empty()) {
-    RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertex_buffer = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-        vertices.size()));
-    auto* index_buffer = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-        triangles.size()));
-    if (!vertex_buffer || !index_buffer) throw std::runtime_error("Embree: " + impl_->error);
-    for (size_t i = 0; i < vertices.size(); ++i) {
-      std::copy_n(vertices[i].data(), 3, vertex_buffer + 3 * i);
-    }
-    for (size_t i = 0; i < triangles.size(); ++i) {
-      for (int k = 0; k < 3; ++k) index_buffer[3 * i + k] = static_cast<unsigned>(triangles[i][k]);
-    }
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(impl_->scene, geometry);
-    rtcReleaseGeometry(geometry);
-  }
-  rtcCommitScene(impl_->scene);
-  if (!impl_->error.empty()) throw std::runtime_error("Embree: " + impl_->error);
+  if (!triangles.empty()) impl_->embree.Add(vertices, triangles);
+  impl_->embree.Commit();
 }
 
-MeshRaycaster::~MeshRaycaster() {
-  if (impl_->scene) rtcReleaseScene(impl_->scene);
-  if (impl_->device) rtcReleaseDevice(impl_->device);
-}
+MeshRaycaster::~MeshRaycaster() = default;
 
 namespace {
 
@@ -98,7 +65,7 @@ std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
       RTCIntersectContext context;
       rtcInitIntersectContext(&context);
       context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      rtcIntersect1M(impl_->scene, &context, rays.data(), static_cast<unsigned>(width),
+      rtcIntersect1M(impl_->embree.Handle(), &context, rays.data(), static_cast<unsigned>(width),
                      sizeof(RTCRayHit));
       for (int x = 0; x < width; ++x) {
         const RTCRayHit& ray = rays[static_cast<size_t>(x)];
@@ -139,14 +106,14 @@ std::vector<uint8_t> MeshRaycaster::Visible(const Eigen::Vector3f& eye,
                                             const std::vector<Eigen::Vector3f>& points,
                                             float tolerance) const {
   // Direction = the whole segment, so t runs from 0 (eye) to 1 (point).
-  return FreeSegments(impl_->scene, points.size(),
+  return FreeSegments(impl_->embree.Handle(), points.size(),
                       [&](size_t i) { return MakeRay(eye, points[i] - eye, 1.0f - tolerance); });
 }
 
 std::vector<uint8_t> MeshRaycaster::Unoccluded(const std::vector<Eigen::Vector3f>& origins,
                                                const Eigen::Vector3f& direction, float length) const {
   const Eigen::Vector3f unit = direction.normalized();
-  return FreeSegments(impl_->scene, origins.size(), [&](size_t i) { return MakeRay(origins[i], unit, length); });
+  return FreeSegments(impl_->embree.Handle(), origins.size(), [&](size_t i) { return MakeRay(origins[i], unit, length); });
 }
 
 }  // namespace parallax

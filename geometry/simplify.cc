@@ -43,7 +43,7 @@ struct KeyHash {
 
 // The triangles that survive clustering, as cell-key triples, each once (whatever the corner
 // order; the first triangle's orientation is kept).
-std::vector<std::array<uint64_t, 3>> ClusteredTriangles(const PlyMesh& mesh, const ClusterGrid& grid) {
+std::vector<std::array<uint64_t, 3>> ClusteredTriangles(const TriangleMesh& mesh, const ClusterGrid& grid) {
   std::vector<uint64_t> keys(mesh.vertices.size());
   for (size_t v = 0; v < mesh.vertices.size(); ++v) keys[v] = grid.Key(mesh.vertices[v]);
   std::vector<std::array<uint64_t, 3>> triangles;
@@ -89,7 +89,7 @@ struct CellQuadric {
   }
 };
 
-PlyMesh Cluster(const PlyMesh& mesh, const ClusterGrid& grid) {
+TriangleMesh Cluster(const TriangleMesh& mesh, const ClusterGrid& grid) {
   std::unordered_map<uint64_t, CellQuadric, KeyHash> quadrics;
   for (const Eigen::Vector3f& v : mesh.vertices) {
     CellQuadric& q = quadrics[grid.Key(v)];
@@ -110,7 +110,7 @@ PlyMesh Cluster(const PlyMesh& mesh, const ClusterGrid& grid) {
       q.b += area * offset * normal;
     }
   }
-  PlyMesh simplified;
+  TriangleMesh simplified;
   std::unordered_map<uint64_t, int, KeyHash> index;
   for (const std::array<uint64_t, 3>& cells : ClusteredTriangles(mesh, grid)) {
     Eigen::Vector3i triangle;
@@ -128,7 +128,7 @@ PlyMesh Cluster(const PlyMesh& mesh, const ClusterGrid& grid) {
 
 }  // namespace
 
-PlyMesh SimplifyMesh(const PlyMesh& mesh, size_t max_triangles) {
+TriangleMesh SimplifyMesh(const TriangleMesh& mesh, size_t max_triangles) {
   if (max_triangles < 1) throw std::invalid_argument("SimplifyMesh: the budget must be at least 1 triangle");
   for (const Eigen::Vector3i& t : mesh.triangles) {
     if (t.minCoeff() < 0 || static_cast<size_t>(t.maxCoeff()) >= mesh.vertices.size()) {

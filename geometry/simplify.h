@@ -13,6 +13,6 @@ namespace parallax {
 // fewer than three distinct cells disappear. The grid is the finest whose result fits the
 // budget. Returns `mesh` unchanged when it already fits. Throws std::invalid_argument for a
 // budget below 1 or triangles indexing outside the vertices.
-PlyMesh SimplifyMesh(const PlyMesh& mesh, size_t max_triangles);
+TriangleMesh SimplifyMesh(const TriangleMesh& mesh, size_t max_triangles);
 
 }  // namespace parallax

@@ -68,10 +68,10 @@ float OctreeCell(const std::vector<Eigen::Vector3f>& points, int depth) {
 }
 
 // Drops triangles with a corner far from the data, and the vertices no triangle uses.
-PlyMesh Trim(const PlyMesh& mesh, const PointGrid& grid, float radius) {
+TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius) {
   std::vector<uint8_t> near(mesh.vertices.size());
   for (size_t v = 0; v < mesh.vertices.size(); ++v) near[v] = grid.AnyWithin(mesh.vertices[v], radius);
-  PlyMesh trimmed;
+  TriangleMesh trimmed;
   std::vector<int> new_index(mesh.vertices.size(), -1);
   for (const Eigen::Vector3i& triangle : mesh.triangles) {
     if (!near[static_cast<size_t>(triangle[0])] || !near[static_cast<size_t>(triangle[1])] ||
@@ -141,16 +141,16 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   fs::rename(temporary, poisson);
 
   progress.Update("trim", 0, 1);
-  const PlyMesh raw = ReadPly(poisson);
+  const TriangleMesh raw = ReadPly(poisson);
   const float cell = OctreeCell(points, options.poisson_depth);
   const float radius = static_cast<float>(options.max_cells_from_data) * cell;
-  const PlyMesh trimmed = Trim(raw, PointGrid(points, radius), radius);
+  const TriangleMesh trimmed = Trim(raw, PointGrid(points, radius), radius);
   progress.Update("trim", 1, 1);
 
   progress.Update("texture", 0, 1);
   const std::vector<TextureView> views = LoadTextureViews(workspace);
   TextureSummary texture;
-  const TexturedMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
+  const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
   WriteTexturedMesh(ws.MeshDir(), textured);
   progress.Update("texture", 1, 1);
 
@@ -158,7 +158,7 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   const fs::path display = ws.DisplayMeshDir();
   if (trimmed.triangles.size() > options.display_max_triangles) {
     progress.Update("display mesh", 0, 1);
-    const PlyMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
+    const TriangleMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
     TextureSummary display_texture;
     WriteTexturedMesh(display, TextureMesh(simplified.vertices, simplified.triangles, views, options.texture,
                                            display_texture));

@@ -163,7 +163,7 @@ void TextureOptions::Check() const {
                 max_view_angle_deg, "(0, 90)");
 }
 
-TexturedMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
+TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles,
                          const std::vector<TextureView>& views, const TextureOptions& options,
                          TextureSummary& summary) {
@@ -189,7 +189,7 @@ TexturedMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
   const int rows = static_cast<int>((static_cast<int>(triangles.size()) + columns - 1) / columns);
   summary.texels_per_edge = texels;
 
-  TexturedMesh mesh;
+  TriangleMesh mesh;
   mesh.vertices = vertices;
   mesh.triangles = triangles;
   mesh.atlas = Image(columns * cell, std::max(rows, 1) * cell, 3);

@@ -10,7 +10,7 @@
 #include "core/camera.h"
 #include "core/image.h"
 #include "core/pose.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 
 namespace parallax {
 
@@ -41,7 +41,7 @@ struct TextureSummary {
 };
 
 // Throws std::invalid_argument for invalid options or views.
-TexturedMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
+TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles,
                          const std::vector<TextureView>& views, const TextureOptions& options,
                          TextureSummary& summary);

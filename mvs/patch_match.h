@@ -48,8 +48,8 @@ struct PatchMatchOptions {
   float sigma_color = 0.12f;
   float sigma_spatial_px = 3.0f;
   // The aggregated cost is the mean of this many lowest view costs (fewer if there are fewer
-  // sources). 1 measured best on a ring of cameras, where many surfaces are seen well by only
-  // the neighbour on one side: within 2% 0.83 against 0.76 with the best half of 4 views.
+  // sources). 1 suits a ring of cameras, where many surfaces are seen well by only the
+  // neighbour on one side.
   int best_views = 1;
   // Windows whose weighted standard deviation is below this are textureless: no depth.
   float min_texture_std = 0.004f;

@@ -51,9 +51,8 @@ struct ReconstructOptions {
   // Neighbours matched on each side by the sequential matcher.
   int sequential_overlap = 20;
   // A camera shared by at least this many photos gets its principal point refined in a final
-  // bundle adjustment (COLMAP keeps it at the image centre): on the real Herz-Jesu-P8 photos,
-  // whose principal point is 11 px off-centre, that brings the mean rotation error from
-  // 0.089 to 0.03 degrees.
+  // bundle adjustment (COLMAP keeps it at the image centre, which skews the rotations of
+  // photos whose principal point is off-centre).
   int refine_principal_point_min_images = 5;
   // The refinement is kept only if the principal point stays within this fraction of the
   // image size from the centre; further off it was not observable and drifted.

@@ -106,8 +106,8 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   RenderSummary summary;
   SourceLibrary library(SourcePathsFor(input));
   const std::vector<NamedCamera> targets =
-      cameras.model.empty() ? CamerasAlongPath(cameras.path, library.Cameras(), library.Names())
-                            : CamerasFromModel(cameras.model);
+      cameras.path ? CamerasAlongPath(*cameras.path, library.Cameras(), library.Names())
+                   : CamerasFromModel(cameras.model);
   summary.source_views = library.Cameras().size();
   const SceneFolder scene{input};
   const bool scene_folder = fs::is_directory(scene.GroundTruth());

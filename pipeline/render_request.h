@@ -4,6 +4,7 @@
 // else (no fused cloud, no mesh).
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -36,10 +37,10 @@ struct RenderSummary {
   double ms_per_view = 0;
 };
 
-// The cameras to render: a COLMAP model, or a path spec (CamerasAlongPath) among the sources.
+// The cameras to render: a COLMAP model, or else a path among the sources.
 struct RenderTargets {
   std::filesystem::path model;
-  std::string path;
+  std::optional<CameraPath> path;
 };
 
 // Called after each view is rendered and written: its index of `count`, camera and view.

@@ -27,10 +27,9 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
 
 // Sets to 0 (no value) every speckle: a 4-connected patch of depth values, neighbours within
 // max_step relative depth of each other, of at most max_pixels pixels. Estimated depth maps
-// carry such specks in the sky and along occluding edges (the courtyard's: ~700 of under 100
-// pixels per view); warped, they float in front of the sky and the fill smears them into
-// streaks. Returns how many values were cleared. Throws std::invalid_argument for
-// max_step <= 0.
+// carry such specks in the sky and along occluding edges; warped, they float in front of the
+// sky and the fill smears them into streaks. Returns how many values were cleared. Throws
+// std::invalid_argument for max_step <= 0.
 int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step);
 
 // Sets to 0 the pixels of `depth` on the near side of a depth edge: within `pixels` (4-steps)

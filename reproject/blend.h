@@ -15,9 +15,7 @@ struct BlendOptions {
   // are blended; farther ones are occluded. In (0, 1). 5%, as ErodeDepthEdges separates
   // occluders from their background: 1% split one surface into front and behind wherever the
   // sources' depths disagree by a little (estimated depth, sampling), and one source's sample
-  // stood alone. Courtyard novel views 1% -> 5%: estimated 27.89 -> 28.10 dB, ground-truth
-  // sources 31.87 -> 31.92; on the small scene 23.39 -> 23.59 and 30.63 -> 30.88 (10%: within
-  // 0.05 dB of 5%).
+  // stood alone.
   double depth_tolerance = 0.05;
   // The surface blended at a pixel is the front-most one that this many sources' samples
   // agree on (within depth_tolerance; fewer where fewer sources landed there; the front-most

@@ -22,16 +22,13 @@ struct FillOptions {
   int directions = 16;
   // kDepthAware: candidates within this relative depth of the farthest one are the
   // background side and are averaged; in (0, 1). 20% averages the background of a
-  // disocclusion over more of its rim (a slanted floor's depth varies along it): courtyard
-  // novel views 10% -> 20%: estimated 28.10 -> 28.17 dB, ground-truth sources 31.92 -> 31.99
-  // (5%: 27.88 / 31.61; 30-99%: within 0.08 dB of 20%).
+  // disocclusion over more of its rim (a slanted floor's depth varies along it).
   double background_tolerance = 0.2;
   // kDepthAware: a hole open to the sky (ClassMap::open_to_sky: its direction may lead past
   // what the sources saw) takes the sky where at least this share of the directions find
   // background at infinity, in (0, 1]; other holes take it only where no direction finds a
-  // surface. Courtyard novel views 1 -> 0.5 (the gap between two walls, hidden behind the
-  // nearer one): ground-truth sources 32.53 -> 32.79 dB, estimated 28.30 -> 28.36 (0.25:
-  // 33.08 / 28.15, as the estimate's holes in far ground, open to the sky above, took it).
+  // surface. Below 1 a gap between two walls, hidden behind the nearer one, gets the sky; too
+  // low a share lets holes in far ground, open to the sky above, take it too.
   double hole_sky_share = 0.5;
   // kInpaint: Telea neighbourhood radius in pixels, > 0.
   double inpaint_radius_px = 3;

@@ -47,26 +47,21 @@ struct ForwardWarpOptions {
   double background_max_step = 0.05;
   // Mesh: colour sampling of the source. kAuto: Catmull-Rom where the target magnifies the source
   // (more than 1.5 target pixels per source pixel), bilinear elsewhere. kBicubic: Catmull-Rom
-  // everywhere, sharper where a sample falls between source pixels (courtyard, ground-truth
-  // sources: 31.99 -> 32.12 dB) at ~2 ms more per 640x480 warp.
+  // everywhere, sharper where a sample falls between source pixels, at some extra warp time.
   TextureFilter texture_filter = TextureFilter::kAuto;
   // Added to the ray angle in the sample's blend weight (WarpBuffer::Weight), so a source that
   // sees the point exactly along the target ray gets a large, finite weight (radians, > 0).
   double angle_epsilon_rad = 0.01;
   // Mesh: added to the ray angle of samples on a silhouette (a surface pixel beside a depth
   // edge, sky or unknown depth; radians, >= 0): the photo mixes the two sides there, and a
-  // source that sees the point away from its silhouettes has its pure colour. 0.5 rad:
-  // courtyard novel views, ground-truth sources 31.99 -> 32.08 dB, estimated 28.17 -> 28.22
-  // (0.25 and 1 within 0.02 dB of it), for ~2% of a render's time; 0 turns it off.
+  // source that sees the point away from its silhouettes has its pure colour. 0 turns it off.
   double silhouette_angle_rad = 0.5;
   // Mesh: a surface sample on the near side of a depth edge (beside a farther surface, sky or
   // unknown depth) is splatted at this share of its footprint, and one on the far side at
-  // 2 - share, so the two still meet (unless one sample wide: then 1); in (0, 1]. The true outline lies anywhere between the
-  // two samples, and a target pixel takes the front-most surface of all its sources, so full
-  // footprints fatten every occluder by the largest overshoot of K sources. Courtyard novel
-  // views, ground-truth sources: 1 -> 0.6: 32.08 -> 32.53 dB (0.5 / 0.7: 32.50 / 32.55);
-  // estimated workspace, with --edge-erosion 1 (was 2), 28.22 -> 28.30 (0.5 / 0.7: 28.31 /
-  // 28.26: 0.6 for both).
+  // 2 - share, so the two still meet (unless one sample wide: then 1); in (0, 1]. The true
+  // outline lies anywhere between the two samples, and a target pixel takes the front-most
+  // surface of all its sources, so full footprints fatten every occluder by the largest
+  // overshoot of K sources.
   double outline_splat_share = 0.6;
 
   void Check() const;  // Throws std::invalid_argument naming the field and value.
@@ -109,8 +104,7 @@ class WarpBuffer {
   float Weight(size_t i) const;
   // Colour and weight of each pixel as four IEEE half floats (R, G, B, weight; simd.h's
   // StoreHalf4): 8 bytes per sample instead of 16 in floats. The warps write them and the
-  // blend reads them all, and the render core waits on memory (K=4 at 1920x1080: 66 MB
-  // instead of 133; render 97.4 / 99.3 / 95.7 -> 95.3 / 92.1 / 92.4 ms in three A/B rounds).
+  // blend reads them all, and the render core waits on memory (half the bytes to move).
   // A half keeps 11 significant bits, 20 times finer than an 8-bit sRGB step anywhere;
   // colour saturates at kMaxHalf.
   const uint16_t* ColorWeights() const { return color_weight_.get(); }  // 4 Size() of them.

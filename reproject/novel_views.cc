@@ -124,14 +124,18 @@ std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
   return cameras;
 }
 
-std::vector<NamedCamera> CamerasAlongPath(const std::string& spec,
-                                          const std::vector<PosedCamera>& sources,
-                                          const std::vector<std::string>& source_names) {
-  if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
+std::string CameraPath::Spec() const {
+  return kind == Kind::kOrbit ? "orbit:" + std::to_string(frames)
+                              : "between:" + from + "," + to + "," + std::to_string(frames);
+}
+
+CameraPath ParseCameraPath(const std::string& spec) {
   const size_t colon = spec.find(':');
   const std::string kind = spec.substr(0, colon);
   const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
-  if (kind == "orbit" && colon != std::string::npos) return Orbit(ParseCount(rest, spec), sources);
+  if (kind == "orbit" && colon != std::string::npos) {
+    return {CameraPath::Kind::kOrbit, ParseCount(rest, spec), "", ""};
+  }
   if (kind == "between" && colon != std::string::npos) {
     std::vector<std::string> parts;
     std::istringstream words(rest);
@@ -139,24 +143,32 @@ std::vector<NamedCamera> CamerasAlongPath(const std::string& spec,
     if (parts.size() != 3) {
       throw BadInputError("--path " + spec + ": expected between:IMAGE_A,IMAGE_B,N");
     }
-    auto find = [&](const std::string& name) -> const PosedCamera& {
-      for (size_t i = 0; i < source_names.size(); ++i) {
-        if (source_names[i] == name || fs::path(source_names[i]).stem() == name) return sources[i];
-      }
-      throw BadInputError("--path " + spec + ": no source image named '" + name + "'");
-    };
-    const PosedCamera& a = find(parts[0]);
-    const PosedCamera& b = find(parts[1]);
-    const int frames = ParseCount(parts[2], spec);
-    std::vector<NamedCamera> cameras;
-    for (int i = 0; i < frames; ++i) {
-      const double t = frames == 1 ? 0.5 : static_cast<double>(i) / (frames - 1);
-      cameras.push_back({FrameName("between", i),
-                         {a.camera, InterpolatePose(a.cam_from_world, b.cam_from_world, t)}});
-    }
-    return cameras;
+    return {CameraPath::Kind::kBetween, ParseCount(parts[2], spec), parts[0], parts[1]};
   }
   throw BadInputError("--path " + spec + ": expected orbit:N or between:IMAGE_A,IMAGE_B,N");
+}
+
+std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
+                                          const std::vector<PosedCamera>& sources,
+                                          const std::vector<std::string>& source_names) {
+  const std::string spec = path.Spec();
+  if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
+  if (path.kind == CameraPath::Kind::kOrbit) return Orbit(path.frames, sources);
+  auto find = [&](const std::string& name) -> const PosedCamera& {
+    for (size_t i = 0; i < source_names.size(); ++i) {
+      if (source_names[i] == name || fs::path(source_names[i]).stem() == name) return sources[i];
+    }
+    throw BadInputError("--path " + spec + ": no source image named '" + name + "'");
+  };
+  const PosedCamera& a = find(path.from);
+  const PosedCamera& b = find(path.to);
+  std::vector<NamedCamera> cameras;
+  for (int i = 0; i < path.frames; ++i) {
+    const double t = path.frames == 1 ? 0.5 : static_cast<double>(i) / (path.frames - 1);
+    cameras.push_back({FrameName("between", i),
+                       {a.camera, InterpolatePose(a.cam_from_world, b.cam_from_world, t)}});
+  }
+  return cameras;
 }
 
 SourceLibrary::SourceLibrary(ViewSetPaths paths) : paths_(std::move(paths)) {

@@ -27,12 +27,23 @@ struct NamedCamera {
 // Every image of a COLMAP model (text or binary), named by the image's stem.
 std::vector<NamedCamera> CamerasFromModel(const std::filesystem::path& model_dir);
 
-// Cameras along a path, with the intrinsics of the first source:
+// A camera path among the sources, with the intrinsics of the first source:
 //   orbit:N          N cameras on a circle around the point the sources look at, at their
 //                    mean height and distance, starting at the first source;
 //   between:A,B,N    N cameras from source image A to B (pose interpolation, both included).
-// Throws BadInputError for a malformed spec or unknown image names.
-std::vector<NamedCamera> CamerasAlongPath(const std::string& spec,
+struct CameraPath {
+  enum class Kind { kOrbit, kBetween };
+  Kind kind = Kind::kOrbit;
+  int frames = 0;
+  std::string from, to;  // kBetween: source image names or stems.
+  std::string Spec() const;  // As ParseCameraPath reads it.
+};
+
+// Throws BadInputError for a malformed spec (the message shows the forms above).
+CameraPath ParseCameraPath(const std::string& spec);
+
+// Throws BadInputError when there are no sources or `path` names an unknown image.
+std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names);
 

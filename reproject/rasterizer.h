@@ -45,8 +45,7 @@ inline void StoreHalf4Clamped(uint16_t* p, F4 value, F4 low) {
 }
 
 // Pixels of a row side by side in a textured block: eight with AVX2, one group instead of two
-// or three across a block about nine pixels wide (K=4 render 640x480 14.9 -> 14.0 ms,
-// 1920x1080 116 -> 111 ms, A/B medians).
+// or three across a block about nine pixels wide.
 using simd::FV;
 using simd::IV;
 using simd::kLanes;
@@ -246,9 +245,7 @@ class Rasterizer {
   // The block walk moves right along a row of source blocks, so the next blocks read the
   // texture and write the target a few dozen pixels further right on the same rows: some
   // twenty streams, more than the hardware prefetcher follows. They are asked for kAhead
-  // pixels ahead: the texture rows once per block, each target row as the block reaches it
-  // (K=4 render 1920x1080: medians 105 -> 98, 108 -> 101 and 110 -> 106 ms in three A/B
-  // runs of four or five rounds; 640x480 13.7 -> 13.0 and 13.7 -> 13.7 ms).
+  // pixels ahead: the texture rows once per block, each target row as the block reaches it.
   static constexpr int kAhead = 32;
 
   void PrefetchTexture(const Corner& a, float side) const {

@@ -50,7 +50,7 @@ class Renderer {
 
   // As the free function Render below, into *result. Its memory is reused: a caller that
   // passes the same result frame after frame allocates nothing per frame (a fresh 640x480
-  // result page-faults ~5 MB, ~1.6 ms of a K=4 render). On a throw *result is unchanged.
+  // result page-faults ~5 MB). On a throw *result is unchanged.
   void Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
               RenderResult* result);
 

@@ -5,7 +5,7 @@
 
 #include "core/workspace.h"
 #include "geometry/raycaster.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "reproject/background.h"
 
 namespace parallax {
@@ -54,7 +54,7 @@ WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& wor
   } else if (!std::filesystem::exists(obj)) {
     result.note = "no " + obj.string() + " (reconstruct makes it; render does not build one for this)";
   } else {
-    const TexturedMesh mesh = ReadTexturedMesh(obj);
+    const TriangleMesh mesh = ReadTexturedMesh(obj);
     caster = std::make_shared<const MeshRaycaster>(mesh.vertices, mesh.triangles);
     result.mesh = true;
     result.note = "from " + obj.string() + " (" + std::to_string(mesh.triangles.size()) + " triangles)";

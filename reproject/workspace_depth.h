@@ -37,7 +37,7 @@ struct WorkspaceDepthPreparation {
 };
 
 // Makes `library` prepare each workspace source's estimated depth map as it is loaded: specks
-// removed (RemoveDepthSpeckles: patches under 1/2000 of the photo, ~700 per courtyard view,
+// removed (RemoveDepthSpeckles: patches under 1/2000 of the photo,
 // which would float in the sky and be smeared into streaks by the fill), then, with
 // DepthHoles::kMesh and the workspace's mesh present, the depth-0 pixels the mesh covers take
 // its depth (Embree, one ray per pixel): estimated depth maps lack depth where matching

@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "geometry/embree_scene.h"
 #include "synth/texture.h"
 
 namespace parallax {
@@ -18,6 +19,8 @@ namespace {
 
 // Segments around a sphere or cylinder: the faceting error is r (1 - cos(pi / 128)) = 3e-4 r.
 constexpr int kRoundSegments = 128;
+// A cylinder's curved side: its first triangles, two per segment (TessellateCylinder).
+constexpr int kCylinderSideTriangles = 2 * kRoundSegments;
 constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 void AddQuad(TriangleMesh& mesh, int a, int b, int c, int d) {
@@ -98,7 +101,6 @@ TriangleMesh TessellateCylinder(const ObjectDesc& object) {
     const int next = (segment + 1) % kRoundSegments;
     AddQuad(mesh, segment, next, kRoundSegments + next, kRoundSegments + segment);
   }
-  mesh.num_side_triangles = static_cast<int>(mesh.triangles.size());
   const int bottom_center = static_cast<int>(mesh.vertices.size());
   mesh.vertices.push_back(object.center.cast<float>());
   mesh.vertices.push_back((object.center + Eigen::Vector3d(0, 0, object.height)).cast<float>());
@@ -156,10 +158,7 @@ TriangleMesh TessellateObject(const ObjectDesc& object) {
 
 struct RayTracer::Impl {
   const SceneDesc& scene;
-  RTCDevice device = nullptr;
-  RTCScene rtc_scene = nullptr;
-  std::vector<TriangleMesh> meshes;  // Indexed by Embree geometry id.
-  std::string device_error;          // Recorded by the callback; never thrown through Embree.
+  EmbreeScene embree{true};
 
   explicit Impl(const SceneDesc& scene_in) : scene(scene_in) {}
 
@@ -171,46 +170,14 @@ struct RayTracer::Impl {
 };
 
 RayTracer::RayTracer(const SceneDesc& scene) : impl_(std::make_unique<Impl>(scene)) {
-  impl_->device = rtcNewDevice(nullptr);
-  if (!impl_->device) throw std::runtime_error("Embree: cannot create a device");
-  rtcSetDeviceErrorFunction(
-      impl_->device,
-      [](void* user, RTCError, const char* message) {
-        static_cast<Impl*>(user)->device_error = message ? message : "unknown error";
-      },
-      impl_.get());
-  impl_->rtc_scene = rtcNewScene(impl_->device);
-  rtcSetSceneFlags(impl_->rtc_scene, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(impl_->rtc_scene, RTC_BUILD_QUALITY_HIGH);
   for (const ObjectDesc& object : scene.objects) {
-    TriangleMesh mesh = TessellateObject(object);
-    RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-        mesh.vertices.size()));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
-        geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-        mesh.triangles.size()));
-    if (!vertices || !indices) throw std::runtime_error("Embree: " + impl_->device_error);
-    for (size_t i = 0; i < mesh.vertices.size(); ++i) {
-      std::copy_n(mesh.vertices[i].data(), 3, vertices + 3 * i);
-    }
-    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-      for (int k = 0; k < 3; ++k) indices[3 * i + k] = static_cast<unsigned>(mesh.triangles[i][k]);
-    }
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(impl_->rtc_scene, geometry);  // Ids count up from 0: the object index.
-    rtcReleaseGeometry(geometry);
-    impl_->meshes.push_back(std::move(mesh));
+    const TriangleMesh mesh = TessellateObject(object);
+    impl_->embree.Add(mesh.vertices, mesh.triangles);  // Ids count up from 0: the object index.
   }
-  rtcCommitScene(impl_->rtc_scene);
-  if (!impl_->device_error.empty()) throw std::runtime_error("Embree: " + impl_->device_error);
+  impl_->embree.Commit();
 }
 
-RayTracer::~RayTracer() {
-  if (impl_->rtc_scene) rtcReleaseScene(impl_->rtc_scene);
-  if (impl_->device) rtcReleaseDevice(impl_->device);
-}
+RayTracer::~RayTracer() = default;
 
 SurfaceSample RayTracer::Impl::Surface(const RTCRayHit& ray, double focal_px) const {
   SurfaceSample surface;
@@ -226,7 +193,7 @@ SurfaceSample RayTracer::Impl::Surface(const RTCRayHit& ray, double focal_px) co
   if (object.type == ShapeType::kSphere) {
     surface.normal = surface.point - object.center;
   } else if (object.type == ShapeType::kCylinder &&
-             static_cast<int>(ray.hit.primID) < meshes[ray.hit.geomID].num_side_triangles) {
+             static_cast<int>(ray.hit.primID) < kCylinderSideTriangles) {
     surface.normal = surface.point - object.center;
     surface.normal.z() = 0;
   } else {
@@ -308,7 +275,7 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  rtcIntersect1M(rtc_scene, &context, rays.data(), static_cast<unsigned>(rays.size()),
+  rtcIntersect1M(embree.Handle(), &context, rays.data(), static_cast<unsigned>(rays.size()),
                  sizeof(RTCRayHit));
 
   std::vector<SurfaceSample> surfaces(rays.size());
@@ -329,7 +296,7 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
     }
   }
   rtcInitIntersectContext(&context);
-  rtcOccluded1M(rtc_scene, &context, shadow_rays.data(),
+  rtcOccluded1M(embree.Handle(), &context, shadow_rays.data(),
                 static_cast<unsigned>(shadow_rays.size()), sizeof(RTCRay));
 
   std::vector<float> light_visible(num_lights);

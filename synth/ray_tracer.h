@@ -7,6 +7,7 @@
 #include "core/depth_map.h"
 #include "core/image.h"
 #include "core/pose.h"
+#include "geometry/triangle_mesh.h"
 #include "synth/scene.h"
 
 namespace parallax {
@@ -35,12 +36,8 @@ class RayTracer {
   std::unique_ptr<Impl> impl_;
 };
 
-// Triangle mesh of one object (world coordinates), as handed to Embree.
-struct TriangleMesh {
-  std::vector<Eigen::Vector3f> vertices;
-  std::vector<Eigen::Vector3i> triangles;
-  int num_side_triangles = 0;  // Cylinder: triangles [0, n) are the curved side.
-};
+// Triangle mesh of one object (world coordinates), as handed to Embree; a cylinder's curved
+// side comes first.
 TriangleMesh TessellateObject(const ObjectDesc& object);
 
 }  // namespace parallax

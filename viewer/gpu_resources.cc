@@ -26,7 +26,7 @@ void SetVertexLayout() {
 // The mesh's positions, shared between triangles and drawn by index, for depth-only passes
 // (the eye's pre-pass, shadow maps, projector depth): a third of the vertex work of the
 // per-corner buffer below, a quarter of its bytes. Position 0 is the only attribute.
-IndexedMesh UploadPositions(const TexturedMesh& mesh) {
+IndexedMesh UploadPositions(const TriangleMesh& mesh) {
   static_assert(sizeof(Eigen::Vector3f) == 3 * sizeof(float) && sizeof(Eigen::Vector3i) == 3 * sizeof(GLuint),
                 "uploaded as packed arrays");
   IndexedMesh d{MakeGlVertexArray(), MakeGlBuffer(), MakeGlBuffer(), static_cast<GLsizei>(mesh.triangles.size() * 3)};
@@ -44,7 +44,7 @@ IndexedMesh UploadPositions(const TexturedMesh& mesh) {
 }
 
 // Unit face normals (zero for a degenerate triangle).
-std::vector<Eigen::Vector3f> FaceNormals(const TexturedMesh& mesh) {
+std::vector<Eigen::Vector3f> FaceNormals(const TriangleMesh& mesh) {
   std::vector<Eigen::Vector3f> normals;
   normals.reserve(mesh.triangles.size());
   for (const Eigen::Vector3i& t : mesh.triangles) {
@@ -58,7 +58,7 @@ std::vector<Eigen::Vector3f> FaceNormals(const TexturedMesh& mesh) {
 // the others (a box keeps its edges, a Poisson pillar loses its facets): the mean of the normals
 // of the corner vertex's faces within the crease angle of this face. Windings of reconstructed
 // meshes are not consistent, so a face pointing the other way counts with its sign flipped.
-std::vector<Eigen::Vector3f> CornerNormals(const TexturedMesh& mesh) {
+std::vector<Eigen::Vector3f> CornerNormals(const TriangleMesh& mesh) {
   constexpr float kCreaseDeg = 40;
   const float crease_cos = std::cos(kCreaseDeg * 3.14159265f / 180);
   const std::vector<Eigen::Vector3f> face = FaceNormals(mesh);
@@ -91,7 +91,7 @@ std::vector<Eigen::Vector3f> CornerNormals(const TexturedMesh& mesh) {
 // The mesh for the eye's shaded pass: a vertex per distinct (position, atlas coordinate, corner
 // normal), drawn by index, so triangles inside an atlas chart and a smooth patch share their
 // corners and llvmpipe shades fewer vertices.
-IndexedMesh UploadShadedMesh(const TexturedMesh& mesh) {
+IndexedMesh UploadShadedMesh(const TriangleMesh& mesh) {
   const std::vector<Eigen::Vector3f> normals = CornerNormals(mesh);
   std::vector<Vertex> vertices;
   std::vector<GLuint> indices;
@@ -127,7 +127,7 @@ IndexedMesh UploadShadedMesh(const TexturedMesh& mesh) {
 // its corner's atlas coordinate (t = 1 - v: the atlas is uploaded top row first). colour.x of a
 // mesh vertex holds its triangle's greatest height above the ground, so planar shadows can drop
 // the ground's own triangles without also dropping the foot of a wall.
-std::vector<Vertex> MeshVertices(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground) {
+std::vector<Vertex> MeshVertices(const TriangleMesh& mesh, const std::optional<GroundPlane>& ground) {
   const std::vector<Eigen::Vector3f> normals = FaceNormals(mesh);
   std::vector<Vertex> vertices;
   vertices.reserve(mesh.triangles.size() * 3);
@@ -169,7 +169,7 @@ Drawable Upload(const std::vector<Vertex>& vertices) {
   return d;
 }
 
-GpuMesh UploadMesh(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground) {
+GpuMesh UploadMesh(const TriangleMesh& mesh, const std::optional<GroundPlane>& ground) {
   GpuMesh uploaded;
   if (mesh.triangles.empty()) return uploaded;
   uploaded.casters = Upload(MeshVertices(mesh, ground));

@@ -5,7 +5,7 @@
 #include <optional>
 #include <vector>
 
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "viewer/gl.h"
 #include "geometry/ground_plane.h"
 
@@ -53,7 +53,7 @@ struct GpuMesh {
 };
 
 // `ground` marks each caster triangle with its height above the ground (planar shadows).
-GpuMesh UploadMesh(const TexturedMesh& mesh, const std::optional<GroundPlane>& ground);
+GpuMesh UploadMesh(const TriangleMesh& mesh, const std::optional<GroundPlane>& ground);
 
 void SetTextureParameters(GLenum filter, GLenum wrap);
 

@@ -11,6 +11,7 @@
 
 #include "viewer/gl.h"
 #include "viewer/gpu_resources.h"
+#include "viewer/overlays.h"
 #include "viewer/shaders.h"
 #include "viewer/view_math.h"
 #include "core/check.h"
@@ -39,124 +40,6 @@ bool HasExtension(std::string_view name) {
   return false;
 }
 
-std::vector<Vertex> PointVertices(const std::vector<ColouredPoint>& points) {
-  std::vector<Vertex> vertices;
-  vertices.reserve(points.size());
-  for (const ColouredPoint& p : points) {
-    vertices.push_back({{p.position.x(), p.position.y(), p.position.z()},
-                        {p.normal.x(), p.normal.y(), p.normal.z()},
-                        {0, 0},
-                        {p.colour[0] / 255.0f, p.colour[1] / 255.0f, p.colour[2] / 255.0f}});
-  }
-  return vertices;
-}
-
-void AddLine(std::vector<Vertex>& lines, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-             const Eigen::Vector3f& colour) {
-  for (const Eigen::Vector3d& p : {a, b}) {
-    lines.push_back({{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())},
-                     {0, 0, 0}, {0, 0}, {colour.x(), colour.y(), colour.z()}});
-  }
-}
-
-// Each source camera as a pyramid from its centre to its image corners at `depth`, with a
-// tick on the top edge so "up" is visible: kFrustumVertices line vertices per camera, in order.
-constexpr int kFrustumVertices = 18;
-std::vector<Vertex> FrustumLines(const std::vector<ViewerSource>& sources, double depth) {
-  std::vector<Vertex> lines;
-  const Eigen::Vector3f colour(0.9f, 0.45f, 0.1f);
-  for (const ViewerSource& source : sources) {
-    const Rigid3d world_from_cam = source.cam_from_world.Inverse();
-    const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
-    const double w = static_cast<double>(source.camera.width), h = static_cast<double>(source.camera.height);
-    Eigen::Vector3d corners[4];
-    const double pixels[4][2] = {{0, 0}, {w, 0}, {w, h}, {0, h}};
-    for (int i = 0; i < 4; ++i) {
-      const Eigen::Vector3d ray((pixels[i][0] - source.camera.PrincipalX()) / source.camera.FocalX(),
-                                (pixels[i][1] - source.camera.PrincipalY()) / source.camera.FocalY(), 1);
-      corners[i] = world_from_cam * (depth * ray);
-    }
-    for (int i = 0; i < 4; ++i) {
-      AddLine(lines, centre, corners[i], colour);
-      AddLine(lines, corners[i], corners[(i + 1) % 4], colour);
-    }
-    const Eigen::Vector3d top = 0.5 * (corners[0] + corners[1]);
-    AddLine(lines, top, top + 0.3 * (top - 0.5 * (corners[2] + corners[3])), colour);
-  }
-  return lines;
-}
-
-// How deep the frusta are drawn: 4% of the scene's robust size, but no more than the median
-// spacing of neighbouring cameras, so a dense rig does not turn into a tangle of lines.
-double FrustumDepth(const ViewerScene& scene) {
-  const double size = static_cast<double>(scene.extent.diagonal().norm());
-  double depth = 0.04 * size;
-  const size_t n = scene.sources.size();
-  if (n < 2 || n > 2000) return depth;  // Quadratic below; 2000 cameras take a few ms.
-  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = i + 1; j < n; ++j) {
-      const double d = (CameraCenter(scene.sources[i].cam_from_world) - CameraCenter(scene.sources[j].cam_from_world)).norm();
-      nearest[i] = std::min(nearest[i], d);
-      nearest[j] = std::min(nearest[j], d);
-    }
-  }
-  std::nth_element(nearest.begin(), nearest.begin() + static_cast<std::ptrdiff_t>(n / 2), nearest.end());
-  return std::clamp(nearest[n / 2], 0.005 * size, depth);
-}
-
-// A round grid step: 1, 2 or 5 times a power of ten, at least `minimum`.
-double NiceStep(double minimum) {
-  const double power = std::pow(10.0, std::floor(std::log10(minimum)));
-  for (double factor : {1.0, 2.0, 5.0, 10.0}) {
-    if (factor * power >= minimum) return factor * power;
-  }
-  return 10 * power;
-}
-
-// A square grid with round steps on the ground (or, without one, under the scene, normal to
-// `up`), covering the footprint of the robust extent: outliers do not stretch it.
-std::vector<Vertex> GridLines(const ViewerScene& scene) {
-  const Eigen::Vector3d up = scene.up;
-  const Eigen::Vector3d centre = scene.Centre().cast<double>();
-  double height = 0;  // Of the grid plane along `up`, relative to the extent's centre.
-  if (scene.ground) {
-    height = -scene.ground->SignedDistance(centre);
-  } else {
-    height = std::numeric_limits<double>::infinity();
-    for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner =
-          scene.extent.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>();
-      height = std::min(height, up.dot(corner - centre));
-    }
-  }
-  const Eigen::Vector3d reference = std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d u = (reference - up * up.dot(reference)).normalized();
-  const Eigen::Vector3d v = up.cross(u);
-  double half = 1e-6 * std::max(1.0, static_cast<double>(scene.Radius()));
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d offset = scene.extent.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c)).cast<double>() - centre;
-    half = std::max({half, std::abs(u.dot(offset)), std::abs(v.dot(offset))});
-  }
-  constexpr int kMinCells = 16;  // Across the footprint.
-  const double step = NiceStep(2 * half / kMinCells);
-  const int cells = static_cast<int>(std::ceil(half / step - 1e-9));
-  // Just under the ground, so the ground mesh hides the grid instead of z-fighting with it;
-  // centred on a multiple of the step, so lines fall on round coordinates.
-  Eigen::Vector3d origin = centre + (height - 1e-3 * static_cast<double>(scene.Radius())) * up;
-  origin += (std::round(u.dot(origin) / step) * step - u.dot(origin)) * u +
-            (std::round(v.dot(origin) / step) * step - v.dot(origin)) * v;
-  const double extent = (cells + 1) * step;
-  std::vector<Vertex> lines;
-  const Eigen::Vector3f colour(0.55f, 0.55f, 0.55f);
-  for (int i = -cells - 1; i <= cells + 1; ++i) {
-    const double s = i * step;
-    AddLine(lines, origin + s * u - extent * v, origin + s * u + extent * v, colour);
-    AddLine(lines, origin - extent * u + s * v, origin + extent * u + s * v, colour);
-  }
-  return lines;
-}
-
 }  // namespace
 
 void FrameSettings::Check() const {
@@ -174,7 +57,7 @@ void FrameSettings::Check() const {
   RequireOption(light.position.allFinite(), "FrameSettings.light.position (norm)", light.position.norm(), "finite");
 }
 
-const TexturedMesh& DisplayedMesh(const ViewerScene& scene, int width, int height) {
+const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int height) {
   constexpr size_t kPixelsPerTriangle = 16;
   const bool too_fine = scene.mesh.triangles.size() * kPixelsPerTriangle > static_cast<size_t>(width) * static_cast<size_t>(height);
   return too_fine && !scene.display_mesh.triangles.empty() ? scene.display_mesh : scene.mesh;

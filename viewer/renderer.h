@@ -112,7 +112,7 @@ class SceneRenderer {
 // The level of detail a width x height frame draws: scene.display_mesh (when it has triangles)
 // if scene.mesh would give a triangle fewer than 16 pixels, else scene.mesh. Finer triangles
 // cost llvmpipe vertex and setup work without adding detail the atlas does not already show.
-const TexturedMesh& DisplayedMesh(const ViewerScene& scene, int width, int height);
+const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int height);
 
 // The source views to project for an eye at `eye`: up to `count` indices into scene.sources,
 // with a photo on disk, nearest by the angle their centres make with the eye at the scene

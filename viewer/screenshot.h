@@ -33,7 +33,7 @@ struct FrameTimes {
 struct Screenshot {
   FrameResult frame;
   ViewCamera view;
-  const TexturedMesh* drawn = nullptr;  // The mesh drawn: the scene's, or its display copy.
+  const TriangleMesh* drawn = nullptr;  // The mesh drawn: the scene's, or its display copy.
   bool display_mesh = false;            // Whether that is the display copy.
   double ms = 0;                        // The first frame, shader compilation included.
   std::vector<std::string> notes;       // What the renderer left out, and why.

@@ -2,11 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <map>
 #include <numbers>
 #include <random>
-#include <sstream>
 
 #include <Eigen/Dense>
 
@@ -15,18 +12,12 @@
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
+#include "geometry/ply.h"
 #include "geometry/robust_bounds.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
 namespace {
-
-size_t PlyTypeSize(const std::string& type) {
-  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
-  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "double" || type == "float64") return 8;
-  return 4;  // int, uint, float and their sized names.
-}
 
 // Mean "up" (-y) of the source cameras in world coordinates; nullopt without cameras or when
 // they disagree so much that the mean is meaningless.
@@ -43,7 +34,7 @@ std::optional<Eigen::Vector3d> CamerasUp(const std::vector<ViewerSource>& source
 
 // Points spread over the mesh by area (deterministic), so a large ground made of two
 // triangles weighs as much as it covers.
-std::vector<Eigen::Vector3f> SampleMesh(const TexturedMesh& mesh, int count) {
+std::vector<Eigen::Vector3f> SampleMesh(const TriangleMesh& mesh, int count) {
   std::vector<double> cumulative;
   double total = 0;
   for (const Eigen::Vector3i& t : mesh.triangles) {
@@ -109,53 +100,13 @@ std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path
 }  // namespace
 
 std::vector<ColouredPoint> ReadColouredPly(const fs::path& path) {
-  const std::string bytes = ReadFileBytes(path);
-  const size_t end = bytes.find("end_header\n");
-  if (!bytes.starts_with("ply\n") || end == std::string::npos) {
-    throw BadInputError(path.string() + ": not a PLY file");
-  }
-  std::istringstream lines(bytes.substr(0, end));
-  size_t count = 0, stride = 0;
-  bool in_vertex = false, little_endian = false;
-  std::map<std::string, size_t> offsets;  // Vertex property -> byte offset in a record.
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream words(line);
-    std::string keyword, type, name;
-    words >> keyword;
-    if (keyword == "format") {
-      words >> type;
-      little_endian = type == "binary_little_endian";
-    } else if (keyword == "element") {
-      if (in_vertex) break;  // The vertex element is the first one in every file we read.
-      words >> name >> count;
-      in_vertex = name == "vertex";
-    } else if (keyword == "property" && in_vertex) {
-      words >> type >> name;
-      if (type == "list") throw BadInputError(path.string() + ": list property in vertices");
-      offsets[name] = stride;
-      stride += PlyTypeSize(type);
-    }
-  }
-  if (!little_endian || !offsets.contains("x") || offsets.at("x") != 0 || !offsets.contains("z")) {
-    throw BadInputError(path.string() +
-                        ": expected binary_little_endian vertices starting with float x y z");
-  }
-  const size_t body = end + std::strlen("end_header\n");
-  if (stride == 0 || (bytes.size() - body) / stride < count) {
-    throw BadInputError(path.string() + ": " + std::to_string(count) +
-                        " vertices announced, the file is shorter");
-  }
-  const bool has_normal = offsets.contains("nx"), has_colour = offsets.contains("red");
-  std::vector<ColouredPoint> points(count);
-  for (size_t i = 0; i < count; ++i) {
-    const char* record = bytes.data() + body + i * stride;
-    ColouredPoint& point = points[i];
-    std::memcpy(point.position.data(), record, 12);
-    point.normal.setZero();
-    if (has_normal) std::memcpy(point.normal.data(), record + offsets.at("nx"), 12);
-    point.colour = {180, 180, 180};
-    if (has_colour) std::memcpy(point.colour.data(), record + offsets.at("red"), 3);
-    if (!point.position.allFinite() || !point.normal.allFinite()) {
+  const TriangleMesh cloud = ReadPly(path);
+  std::vector<ColouredPoint> points(cloud.vertices.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    points[i].position = cloud.vertices[i];
+    points[i].normal = cloud.normals.empty() ? Eigen::Vector3f::Zero() : cloud.normals[i];
+    points[i].colour = cloud.colours.empty() ? std::array<uint8_t, 3>{180, 180, 180} : cloud.colours[i];
+    if (!points[i].normal.allFinite()) {
       throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }
   }

@@ -13,7 +13,7 @@
 
 #include "core/camera.h"
 #include "core/pose.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "geometry/ground_plane.h"
 
 namespace parallax {
@@ -43,10 +43,10 @@ struct CameraRig {
 };
 
 struct ViewerScene {
-  TexturedMesh mesh;                 // No triangles when the workspace has no mesh.
+  TriangleMesh mesh;                 // No triangles when the workspace has no mesh.
   // A simplified copy for views whose pixels cannot show every triangle of `mesh`; no
   // triangles when the workspace has none (a small mesh is displayed as it is).
-  TexturedMesh display_mesh;
+  TriangleMesh display_mesh;
   std::vector<ColouredPoint> points; // Empty when the workspace has no fused.ply.
   std::vector<ViewerSource> sources;
   Eigen::AlignedBox3f bounds;        // Exact bounds of the mesh and the points: for clipping.
@@ -81,9 +81,8 @@ ViewerScene LoadViewerScene(const std::filesystem::path& workspace);
 // Throws BadInputError if the scene has neither triangles nor points.
 void FinishViewerScene(ViewerScene& scene);
 
-// Positions, normals and colours of a binary little-endian PLY vertex element (our fused.ply
-// and COLMAP's): float x y z, optional float nx ny nz, optional uchar red green blue.
-// Throws BadInputError naming the file.
+// The points of a PLY cloud (our fused.ply or COLMAP's), read by geometry/ply.h: normals zero
+// and colours grey where the file has none. Throws BadInputError naming the file.
 std::vector<ColouredPoint> ReadColouredPly(const std::filesystem::path& path);
 
 // The rig of cameras looking in at a common point: nullopt with fewer than 3 cameras, when

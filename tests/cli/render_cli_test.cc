@@ -11,7 +11,7 @@
 #include "core/depth_map.h"
 #include "core/image.h"
 #include "core/workspace.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 
@@ -111,7 +111,7 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
 
   // With a mesh in the workspace (here the ground plane, z = 0 in the known cameras' frame),
   // the pixels the depth maps have no depth for take the mesh's: fewer holes.
-  TexturedMesh ground;
+  TriangleMesh ground;
   ground.vertices = {{-20, -20, 0}, {20, -20, 0}, {20, 20, 0}, {-20, 20, 0}};
   ground.triangles = {{0, 1, 2}, {0, 2, 3}};
   ground.corner_uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 0}, {1, 1}, {0, 1}};

@@ -9,8 +9,8 @@ namespace parallax {
 namespace {
 
 // A UV sphere of radius `radius` with `rings` x `segments` quads (two triangles each).
-PlyMesh Sphere(double radius, int rings, int segments) {
-  PlyMesh mesh;
+TriangleMesh Sphere(double radius, int rings, int segments) {
+  TriangleMesh mesh;
   for (int r = 0; r <= rings; ++r) {
     const double theta = std::numbers::pi * r / rings;
     for (int s = 0; s < segments; ++s) {
@@ -31,8 +31,8 @@ PlyMesh Sphere(double radius, int rings, int segments) {
 }
 
 // A flat grid of n x n quads in the plane z = height.
-PlyMesh FlatGrid(int n, float height) {
-  PlyMesh mesh;
+TriangleMesh FlatGrid(int n, float height) {
+  TriangleMesh mesh;
   for (int y = 0; y <= n; ++y) {
     for (int x = 0; x <= n; ++x) mesh.vertices.emplace_back(static_cast<float>(x), static_cast<float>(y), height);
   }
@@ -47,8 +47,8 @@ PlyMesh FlatGrid(int n, float height) {
 }
 
 TEST(SimplifyMesh, SphereFitsTheBudgetCloselyAndStaysOnTheSurface) {
-  const PlyMesh sphere = Sphere(2.0, 100, 200);  // 40000 triangles.
-  const PlyMesh simplified = SimplifyMesh(sphere, 4000);
+  const TriangleMesh sphere = Sphere(2.0, 100, 200);  // 40000 triangles.
+  const TriangleMesh simplified = SimplifyMesh(sphere, 4000);
   EXPECT_LE(simplified.triangles.size(), 4000u);
   // The finest grid that fits: not far below the budget.
   EXPECT_GE(simplified.triangles.size(), 3000u);  // 3882 measured.
@@ -64,7 +64,7 @@ TEST(SimplifyMesh, SphereFitsTheBudgetCloselyAndStaysOnTheSurface) {
 
 TEST(SimplifyMesh, FlatPatchStaysExactlyFlat) {
   // The quadric of a plane is singular along it: the representative must not wander off.
-  const PlyMesh simplified = SimplifyMesh(FlatGrid(100, 3.5f), 2000);
+  const TriangleMesh simplified = SimplifyMesh(FlatGrid(100, 3.5f), 2000);
   ASSERT_GT(simplified.triangles.size(), 1000u);
   EXPECT_LE(simplified.triangles.size(), 2000u);
   for (const Eigen::Vector3f& v : simplified.vertices) {
@@ -76,12 +76,12 @@ TEST(SimplifyMesh, FlatPatchStaysExactlyFlat) {
 }
 
 TEST(SimplifyMesh, MeshWithinBudgetIsReturnedUnchangedAndBadInputIsRefused) {
-  const PlyMesh grid = FlatGrid(4, 0);
-  const PlyMesh same = SimplifyMesh(grid, grid.triangles.size());
+  const TriangleMesh grid = FlatGrid(4, 0);
+  const TriangleMesh same = SimplifyMesh(grid, grid.triangles.size());
   EXPECT_EQ(same.triangles, grid.triangles);
   EXPECT_EQ(same.vertices, grid.vertices);
   EXPECT_THROW(SimplifyMesh(grid, 0), std::invalid_argument);
-  PlyMesh broken = grid;
+  TriangleMesh broken = grid;
   broken.triangles.back()[2] = static_cast<int>(grid.vertices.size());
   EXPECT_THROW(SimplifyMesh(broken, 1), std::invalid_argument);
 }

@@ -11,7 +11,7 @@
 #include "core/workspace.h"
 #include "eval/mesh_evaluation.h"
 #include "geometry/ply.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -42,8 +42,8 @@ TextureView PlaneView() {
 }
 
 // A grid of quads on the plane, wider than the view.
-PlyMesh PlaneMesh(int cells) {
-  PlyMesh mesh;
+TriangleMesh PlaneMesh(int cells) {
+  TriangleMesh mesh;
   const double half = 4;
   for (int j = 0; j <= cells; ++j) {
     for (int i = 0; i <= cells; ++i) {
@@ -64,9 +64,9 @@ PlyMesh PlaneMesh(int cells) {
 
 TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
   const TextureView view = PlaneView();
-  const PlyMesh plane = PlaneMesh(40);
+  const TriangleMesh plane = PlaneMesh(40);
   TextureSummary summary;
-  const TexturedMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
+  const TriangleMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
   // Triangles outside the view stay untextured; the ones inside are ~2.6 px large.
   EXPECT_GT(summary.untextured_triangles, 0u);
   EXPECT_LT(summary.untextured_triangles, plane.triangles.size());
@@ -95,12 +95,12 @@ TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
 TEST(Texture, TexturedMeshFilesRoundTrip) {
   const TempDir dir;
   const TextureView view = PlaneView();
-  const PlyMesh plane = PlaneMesh(4);
+  const TriangleMesh plane = PlaneMesh(4);
   TextureSummary summary;
-  const TexturedMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
+  const TriangleMesh mesh = TextureMesh(plane.vertices, plane.triangles, {view}, {}, summary);
   WriteTexturedMesh(Workspace(dir.Path()).MeshDir(), mesh);
   EXPECT_FALSE(std::filesystem::exists(dir.Path() / "mesh.tmp"));
-  const TexturedMesh read = ReadTexturedMesh(Workspace(dir.Path()).Mesh());
+  const TriangleMesh read = ReadTexturedMesh(Workspace(dir.Path()).Mesh());
   ASSERT_EQ(read.triangles.size(), mesh.triangles.size());
   ASSERT_EQ(read.corner_uvs.size(), mesh.corner_uvs.size());
   for (size_t i = 0; i < mesh.corner_uvs.size(); ++i) {
@@ -142,7 +142,7 @@ TEST(Ply, ReadsMeshesAndRejectsIndicesOutOfRange) {
     file.write(reinterpret_cast<const char*>(indices), sizeof(indices));
   };
   write(2);
-  const PlyMesh mesh = ReadPly(dir.Path() / "m.ply");
+  const TriangleMesh mesh = ReadPly(dir.Path() / "m.ply");
   ASSERT_EQ(mesh.vertices.size(), 3u);
   ASSERT_EQ(mesh.triangles.size(), 1u);
   EXPECT_EQ(mesh.triangles[0], Eigen::Vector3i(0, 1, 2));

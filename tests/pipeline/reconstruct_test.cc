@@ -19,7 +19,7 @@
 #include "geometry/ply.h"
 #include "eval/register_held_out.h"
 #include "mvs/sgbm.h"
-#include "geometry/textured_mesh.h"
+#include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "eval/depth_evaluation.h"
 #include "eval/evaluate.h"
@@ -176,7 +176,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // The textured mesh: on the true surfaces, readable by a standard tool, and its renders
   // reproduce the photos.
   const std::filesystem::path obj = Workspace(workspace.Path()).Mesh();
-  const TexturedMesh mesh = ReadTexturedMesh(obj);
+  const TriangleMesh mesh = ReadTexturedMesh(obj);
   EXPECT_GT(mesh.triangles.size(), 5000u);
   const CloudAccuracy vertices = MeasureCloud(mesh.vertices, truth, scene.Training().depth, {});
   EXPECT_LT(vertices.median_relative_distance, 0.005);

@@ -1,0 +1,30 @@
+#pragma once
+// A textured triangle mesh's files: Wavefront OBJ + MTL + PNG atlas, the format every mesh
+// tool opens (<ws>/mesh/mesh.obj|.mtl|.png).
+#include <filesystem>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/image.h"
+#include "geometry/triangle_mesh.h"
+
+namespace parallax {
+
+// Writes <dir>/mesh.obj, mesh.mtl and mesh.png through a temporary folder renamed into place,
+// so a reader never sees a mix of old and new files.
+void WriteTexturedMesh(const std::filesystem::path& dir, const TriangleMesh& mesh);
+
+// Reads an OBJ (tinyobjloader) with triangles whose corners all have texture coordinates, and
+// the atlas its MTL names (map_Kd). Throws BadInputError naming the file, and the line where
+// one is at fault, for anything else.
+TriangleMesh ReadTexturedMesh(const std::filesystem::path& obj_path);
+
+// Colour (first 3 channels) at a continuous pixel position (pixel centres at integer + 0.5),
+// bilinear between pixel centres, clamped at the border.
+Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel);
+
+// Atlas colour at `uv` (OBJ convention), through SampleBilinear.
+Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv);
+
+}  // namespace parallax

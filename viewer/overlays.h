@@ -1,0 +1,29 @@
+#pragma once
+// What the viewer draws besides the surfaces, as vertices for the GPU: the fused cloud's
+// points, each source camera's frustum, and a grid on the ground.
+#include <vector>
+
+#include "viewer/gpu_resources.h"
+#include "viewer/viewer_scene.h"
+
+namespace parallax {
+
+// Line vertices per camera in FrustumLines: a pyramid from the centre to the image corners,
+// and a tick on its top edge.
+constexpr int kFrustumVertices = 18;
+
+std::vector<gpu::Vertex> PointVertices(const std::vector<ColouredPoint>& points);
+
+// Each source camera as a pyramid from its centre to its image corners at `depth`, with a
+// tick on the top edge so "up" is visible: kFrustumVertices line vertices per camera, in order.
+std::vector<gpu::Vertex> FrustumLines(const std::vector<ViewerSource>& sources, double depth);
+
+// How deep the frusta are drawn: 4% of the scene's robust size, but no more than the median
+// spacing of neighbouring cameras, so a dense rig does not turn into a tangle of lines.
+double FrustumDepth(const ViewerScene& scene);
+
+// A square grid with round steps on the ground (or, without one, under the scene, normal to
+// `up`), covering the footprint of the robust extent: outliers do not stretch it.
+std::vector<gpu::Vertex> GridLines(const ViewerScene& scene);
+
+}  // namespace parallax
