@@ -34,7 +34,7 @@ void AddNovelViewOptions(CLI::App& command, NovelViewSettings& settings) {
   const std::map<std::string, TextureFilter> filters = {{"auto", TextureFilter::kAuto},
                                                         {"bicubic", TextureFilter::kBicubic}};
   command.add_option("--texture-filter", settings.render.warp.texture_filter,
-                     "mesh warp colour sampling: auto (default; Catmull-Rom where the view "
+                     "mesh warp color sampling: auto (default; Catmull-Rom where the view "
                      "magnifies a source, bilinear elsewhere) or bicubic (Catmull-Rom everywhere: "
                      "sharper, ~10% slower)")
       ->transform(CLI::CheckedTransformer(filters, CLI::ignore_case));

@@ -64,8 +64,8 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
                             a.timed_frames};
   const Screenshot shot = TakeScreenshot(scene, settings, options);
   for (const std::string& note : shot.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
-  std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), shot.frame.colour.Width(),
-              shot.frame.colour.Height(), shot.ms);
+  std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), shot.frame.color.Width(),
+              shot.frame.color.Height(), shot.ms);
   if (shot.display_mesh) {
     std::printf("level of detail: the display mesh, %zu of %zu triangles\n", shot.drawn->triangles.size(),
                 scene.mesh.triangles.size());

@@ -1,6 +1,6 @@
 // Render timings on example_images/courtyard (640x480, ground-truth depth): a novel view from
 // its K best training views, per warp method, texture filter and fill method; and the same scene at
-// 1920x1080 (every view upsampled 3x, bilinear colour, nearest depth, and cropped to 16:9).
+// 1920x1080 (every view upsampled 3x, bilinear color, nearest depth, and cropped to 16:9).
 // The hot loops alone too: one forward warp, the blend of four, classification and filling;
 // and the K=4 render on one thread. Counter: target pixels / s.
 #include <benchmark/benchmark.h>

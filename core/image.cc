@@ -29,10 +29,10 @@ bool HasAlpha(const Image& image) { return image.Channels() == 2 || image.Channe
 
 Image MapColorChannels(const Image& input, float (*function)(float)) {
   Image output = input;
-  const int colour_channels = HasAlpha(input) ? input.Channels() - 1 : input.Channels();
+  const int color_channels = HasAlpha(input) ? input.Channels() - 1 : input.Channels();
   std::vector<float>& pixels = output.Pixels();
   for (size_t i = 0; i < pixels.size(); ++i) {
-    if (static_cast<int>(i % static_cast<size_t>(input.Channels())) < colour_channels) {
+    if (static_cast<int>(i % static_cast<size_t>(input.Channels())) < color_channels) {
       pixels[i] = function(pixels[i]);
     }
   }
@@ -55,7 +55,7 @@ void Image::Reset(int width, int height, int channels) {
 }
 
 Image ReadImage(const fs::path& path) {
-  // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG colour by alpha.
+  // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG color by alpha.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
   auto input = OIIO::ImageInput::open(path.string(), &config);
@@ -103,7 +103,7 @@ void WriteImage(const fs::path& path, const Image& image, PixelFormat format,
     if (image.Channels() == 1) spec.channelnames = {"Y"};
     if (HasAlpha(image)) {
       spec.alpha_channel = image.Channels() - 1;
-      spec.attribute("oiio:UnassociatedAlpha", 1);  // Colour is not premultiplied.
+      spec.attribute("oiio:UnassociatedAlpha", 1);  // Color is not premultiplied.
     }
     spec.attribute("compression", "zip");
     spec.attribute("png:compressionLevel", png == PngCompression::kFast ? 1 : 6);

@@ -3,7 +3,7 @@
 //
 // Common principles:
 //  - In memory an image is float, interleaved, row-major, with 1..4 channels, holding the
-//    values the file holds scaled to [0, 1] for integer formats. No colour conversion happens
+//    values the file holds scaled to [0, 1] for integer formats. No color conversion happens
 //    behind the caller's back: 8-bit files are sRGB-encoded, EXR files are linear, and the
 //    caller converts explicitly with SrgbToLinear / LinearToSrgb.
 //  - Readers throw BadInputError naming the file and the problem; writers refuse NaN or Inf
@@ -67,7 +67,7 @@ enum class PngCompression { kFast, kSmall };
 void WriteImage(const std::filesystem::path& path, const Image& image, PixelFormat format,
                 PngCompression png = PngCompression::kFast);
 
-// sRGB transfer function (IEC 61966-2-1) on the colour channels; alpha (channel 4, or 2 of a
+// sRGB transfer function (IEC 61966-2-1) on the color channels; alpha (channel 4, or 2 of a
 // grey+alpha image) is left as it is.
 float SrgbToLinear(float encoded);
 float LinearToSrgb(float linear);

@@ -1,6 +1,6 @@
 #pragma once
 // Image quality against a reference, as docs/design.md's evaluate JSON defines it: on sRGB values
-// in [0, 1], colour channels only (alpha ignored).
+// in [0, 1], color channels only (alpha ignored).
 #include <cstdint>
 #include <vector>
 

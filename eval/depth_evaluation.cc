@@ -23,7 +23,7 @@ namespace {
 // The 4 ground-truth depths around a sub-pixel location are interpolated only when they lie
 // within this ratio of each other: across a depth edge interpolation would invent a surface.
 constexpr double kInterpolationMaxRatio = 1.01;
-// abs_rel at which the error colour ramp reaches red.
+// abs_rel at which the error color ramp reaches red.
 constexpr double kErrorRampMax = 0.02;
 constexpr float kNoTruthGrey = 0.5f;
 

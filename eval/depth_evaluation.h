@@ -54,7 +54,7 @@ struct DepthEvaluation : DepthErrors {
 // one nearest to the camera counts.
 //
 // With a non-empty `error_image_dir`, writes `<dir>/<stem>.png` per view (ground-truth camera
-// size, sRGB 8-bit): abs_rel colour-mapped (DepthErrorColor), black where the ground truth has
+// size, sRGB 8-bit): abs_rel color-mapped (DepthErrorColor), black where the ground truth has
 // depth but no estimate landed, mid grey where the ground truth has no depth.
 //
 // Throws BadInputError naming the file for a depth map whose size differs from its camera, a
@@ -67,7 +67,7 @@ DepthEvaluation EvaluateDepth(const SparseModel& estimate_model,
                               const Similarity3d& truth_from_estimate,
                               const std::filesystem::path& error_image_dir);
 
-// The colour (sRGB values in [0, 1]) of an abs_rel error in the error images: a ramp from
+// The color (sRGB values in [0, 1]) of an abs_rel error in the error images: a ramp from
 // dark blue (0) through teal and yellow-green (1%) and orange to red (2% and above).
 Eigen::Vector3f DepthErrorColor(double abs_rel);
 

@@ -20,10 +20,10 @@ Image RenderTexturedMesh(const TriangleMesh& mesh, const MeshRaycaster& raycaste
     if (hit.triangle < 0) continue;
     const Eigen::Vector2f* uv = &mesh.corner_uvs[3 * static_cast<size_t>(hit.triangle)];
     const Eigen::Vector2f at = (1 - hit.u - hit.v) * uv[0] + hit.u * uv[1] + hit.v * uv[2];
-    const Eigen::Vector3f colour = SampleAtlas(mesh.atlas, at);
+    const Eigen::Vector3f color = SampleAtlas(mesh.atlas, at);
     for (int c = 0; c < 3; ++c) {
       render.At(static_cast<int>(i % static_cast<size_t>(width)),
-                static_cast<int>(i / static_cast<size_t>(width)), c) = colour[c];
+                static_cast<int>(i / static_cast<size_t>(width)), c) = color[c];
     }
     covered[i] = 1;
   }

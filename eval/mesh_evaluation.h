@@ -22,7 +22,7 @@ TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel&
                                     const std::filesystem::path& images_dir,
                                     const std::filesystem::path& render_dir);
 
-// The textured mesh seen from a camera: sRGB colour where covered, `covered` set there.
+// The textured mesh seen from a camera: sRGB color where covered, `covered` set there.
 // `raycaster` holds `mesh`'s triangles (built once, shared by all views).
 Image RenderTexturedMesh(const TriangleMesh& mesh, const MeshRaycaster& raycaster,
                          const Camera& camera, const Rigid3d& cam_from_world,

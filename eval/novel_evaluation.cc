@@ -11,7 +11,7 @@ namespace parallax {
 namespace fs = std::filesystem;
 namespace {
 
-Eigen::Vector3f ClassColour(PixelClass pixel_class) {
+Eigen::Vector3f ClassColor(PixelClass pixel_class) {
   switch (pixel_class) {
     case PixelClass::kCovered: return {0, 0, 0};
     case PixelClass::kBackground: return {0.2f, 0.4f, 1};
@@ -28,7 +28,7 @@ Image SideBySide(const Image& render, const Image& truth, const ClassMap& classe
   Image out(4 * w, h, 3);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Eigen::Vector3f pixel_class = ClassColour(classes.At(x, y));
+      const Eigen::Vector3f pixel_class = ClassColor(classes.At(x, y));
       for (int c = 0; c < 3; ++c) {
         out.At(x, y, c) = render.At(x, y, c);
         out.At(w + x, y, c) = truth.At(x, y, c);

@@ -166,12 +166,12 @@ Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel)
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
   const int x1 = std::min(x0 + 1, image.Width() - 1), y1 = std::min(y0 + 1, image.Height() - 1);
   const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
-  Eigen::Vector3f colour;
+  Eigen::Vector3f color;
   for (int c = 0; c < 3; ++c) {
-    colour[c] = (1 - fy) * ((1 - fx) * image.At(x0, y0, c) + fx * image.At(x1, y0, c)) +
+    color[c] = (1 - fy) * ((1 - fx) * image.At(x0, y0, c) + fx * image.At(x1, y0, c)) +
                 fy * ((1 - fx) * image.At(x0, y1, c) + fx * image.At(x1, y1, c));
   }
-  return colour;
+  return color;
 }
 
 Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv) {

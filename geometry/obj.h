@@ -20,11 +20,11 @@ void WriteTexturedMesh(const std::filesystem::path& dir, const TriangleMesh& mes
 // one is at fault, for anything else.
 TriangleMesh ReadTexturedMesh(const std::filesystem::path& obj_path);
 
-// Colour (first 3 channels) at a continuous pixel position (pixel centres at integer + 0.5),
+// Color (first 3 channels) at a continuous pixel position (pixel centres at integer + 0.5),
 // bilinear between pixel centres, clamped at the border.
 Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel);
 
-// Atlas colour at `uv` (OBJ convention), through SampleBilinear.
+// Atlas color at `uv` (OBJ convention), through SampleBilinear.
 Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv);
 
 }  // namespace parallax

@@ -137,15 +137,15 @@ void ReadVertices(const std::string& bytes, const Element& element, size_t& offs
                         " vertices announced, the file is shorter");
   }
   const std::optional<size_t> normal = TripleOffset(element, "float", {"nx", "ny", "nz"});
-  const std::optional<size_t> colour = TripleOffset(element, "uchar", {"red", "green", "blue"});
+  const std::optional<size_t> color = TripleOffset(element, "uchar", {"red", "green", "blue"});
   mesh.vertices.resize(element.count);
   if (normal) mesh.normals.resize(element.count);
-  if (colour) mesh.colours.resize(element.count);
+  if (color) mesh.colors.resize(element.count);
   for (size_t i = 0; i < element.count; ++i) {
     const char* record = bytes.data() + offset + i * element.stride;
     std::memcpy(mesh.vertices[i].data(), record, 12);
     if (normal) std::memcpy(mesh.normals[i].data(), record + *normal, 12);
-    if (colour) std::memcpy(mesh.colours[i].data(), record + *colour, 3);
+    if (color) std::memcpy(mesh.colors[i].data(), record + *color, 3);
     if (!mesh.vertices[i].allFinite()) {
       throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }

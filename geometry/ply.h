@@ -1,7 +1,7 @@
 #pragma once
 // Reading binary little-endian PLY files: our fused clouds, COLMAP's fused.ply and the meshes
 // `colmap poisson_mesher` writes. Only what parallax needs: vertex positions (float x, y, z as
-// the first three vertex properties), normals (float nx, ny, nz) and colours (uchar red, green,
+// the first three vertex properties), normals (float nx, ny, nz) and colors (uchar red, green,
 // blue) when present, any other property skipped, and triangle faces (a `vertex_indices`
 // list). Every count and index is checked against the file before use.
 #include <filesystem>

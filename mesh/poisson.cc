@@ -100,7 +100,7 @@ std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
     TextureView view;
     view.camera = model.CameraById(image.camera_id);
     view.cam_from_world = image.cam_from_world;
-    view.colour = SrgbToLinear(ReadImage(ws.Image(image.name)));
+    view.color = SrgbToLinear(ReadImage(ws.Image(image.name)));
     views.push_back(std::move(view));
   }
   return views;

@@ -20,7 +20,7 @@ struct Candidate {
   float score = 0;
 };
 constexpr int kMaxCandidates = 8;
-// How far beyond a photo's border a texel may lie and still take the border's colour.
+// How far beyond a photo's border a texel may lie and still take the border's color.
 constexpr float kBorderPixels = 4;
 using Candidates = std::array<Candidate, kMaxCandidates>;  // Best first; view -1 ends the list.
 
@@ -82,7 +82,7 @@ std::vector<Candidates> RankViews(const std::vector<Eigen::Vector3f>& vertices,
         if (!visible[t]) continue;
         const Eigen::Vector3i& tri = triangles[t];
         // In view: every corner in front of the camera, and the triangle's bounding box
-        // overlapping the photo (texels beyond its border take the border's colour).
+        // overlapping the photo (texels beyond its border take the border's color).
         std::array<Eigen::Vector2f, 3> pixels;
         bool in_front = true;
         for (int c = 0; c < 3 && in_front; ++c) {
@@ -130,8 +130,8 @@ double MedianEdgePixels(const std::vector<Eigen::Vector3f>& vertices,
   return static_cast<double>(edges[edges.size() / 2]);
 }
 
-// Linear colour of a surface point from the triangle's ranked photos.
-Eigen::Vector3f BlendedColour(const Eigen::Vector3f& point, const Candidates& candidates,
+// Linear color of a surface point from the triangle's ranked photos.
+Eigen::Vector3f BlendedColor(const Eigen::Vector3f& point, const Candidates& candidates,
                               const std::vector<TextureView>& views, double exponent) {
   Eigen::Vector3f sum = Eigen::Vector3f::Zero();
   float total = 0;
@@ -143,7 +143,7 @@ Eigen::Vector3f BlendedColour(const Eigen::Vector3f& point, const Candidates& ca
     if (!ProjectPinhole(view, point, pixel, depth) || !Inside(view, pixel, -kBorderPixels)) continue;
     const float weight = static_cast<float>(
         std::pow(static_cast<double>(candidate.score / candidates[0].score), exponent));
-    sum += weight * SampleBilinear(view.colour, pixel);
+    sum += weight * SampleBilinear(view.color, pixel);
     total += weight;
   }
   return total > 0 ? Eigen::Vector3f(sum / total) : Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
@@ -169,8 +169,8 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          TextureSummary& summary) {
   options.Check();
   for (const TextureView& view : views) {
-    if (view.camera.HasDistortion() || static_cast<uint64_t>(view.colour.Width()) != view.camera.width ||
-        static_cast<uint64_t>(view.colour.Height()) != view.camera.height || view.colour.Channels() < 3) {
+    if (view.camera.HasDistortion() || static_cast<uint64_t>(view.color.Width()) != view.camera.width ||
+        static_cast<uint64_t>(view.color.Height()) != view.camera.height || view.color.Channels() < 3) {
       throw std::invalid_argument("texture: views must be distortion-free with RGB images of the camera's size");
     }
   }
@@ -178,7 +178,7 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
 
   // One square cell per triangle: the triangle fills the lower-left half of the cell's inner
   // part, one texel of margin all round. Texels outside the triangle repeat its nearest point,
-  // so bilinear filtering never reaches a neighbour's colours.
+  // so bilinear filtering never reaches a neighbour's colors.
   const double cells_per_side = std::ceil(std::sqrt(static_cast<double>(std::max<size_t>(triangles.size(), 1))));
   const int largest_edge = static_cast<int>(options.max_atlas_size / cells_per_side) - 2;
   const int texels = std::clamp(static_cast<int>(std::ceil(MedianEdgePixels(vertices, triangles, views, ranked))),
@@ -224,10 +224,10 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
             a /= sum;
             b /= sum;
           }
-          const Eigen::Vector3f colour =
-              BlendedColour(v0 + a * e1 + b * e2, ranked[t], views, options.blend_exponent);
+          const Eigen::Vector3f color =
+              BlendedColor(v0 + a * e1 + b * e2, ranked[t], views, options.blend_exponent);
           for (int c = 0; c < 3; ++c) {
-            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(colour[c]), 0.0f, 1.0f);
+            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(color[c]), 0.0f, 1.0f);
           }
         }
       }

@@ -1,5 +1,5 @@
 #pragma once
-// Texturing a mesh from the photos: every triangle gets its own cell in one atlas, coloured
+// Texturing a mesh from the photos: every triangle gets its own cell in one atlas, colored
 // from the photo that sees it best (most head-on and most pixels per unit area) without
 // occlusion (Embree visibility). Photos nearly as good are blended in with a steeply falling
 // weight, so the seam between triangles that chose different photos fades instead of jumping.
@@ -17,7 +17,7 @@ namespace parallax {
 struct TextureView {
   Camera camera;  // Distortion-free (the undistorted workspace).
   Rigid3d cam_from_world;
-  Image colour;   // Linear RGB, camera.width x camera.height.
+  Image color;   // Linear RGB, camera.width x camera.height.
 };
 
 struct TextureOptions {

@@ -23,7 +23,7 @@ struct FusionView {
   Eigen::Matrix3d world_from_cam;
   DepthMap depth;
   DenseArray normals;  // Camera frame, channel-major (COLMAP layout).
-  Image colour;        // Linear RGB.
+  Image color;        // Linear RGB.
   std::vector<uint8_t> used;
 
   size_t Pixels() const { return static_cast<size_t>(depth.Width()) * depth.Height(); }
@@ -47,10 +47,10 @@ std::vector<FusionView> LoadViews(const fs::path& workspace) {
     view.world_from_cam = image.cam_from_world.rotation.conjugate().toRotationMatrix();
     view.depth = ReadDepthExr(depth_path);
     view.normals = ReadColmapArray(normal_path);
-    view.colour = SrgbToLinear(ReadImage(ws.Image(image.name)));
+    view.color = SrgbToLinear(ReadImage(ws.Image(image.name)));
     if (view.normals.width != view.depth.Width() || view.normals.height != view.depth.Height() ||
-        view.normals.channels != 3 || view.colour.Width() != view.depth.Width() ||
-        view.colour.Height() != view.depth.Height()) {
+        view.normals.channels != 3 || view.color.Width() != view.depth.Width() ||
+        view.color.Height() != view.depth.Height()) {
       throw BadInputError("fusion: depth, normal map and image of " + image.name +
                           " differ in size");
     }
@@ -87,8 +87,8 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
         const Eigen::Vector3d point = reference.world_from_cam *
             (*reference.camera.Unproject({x + 0.5, y + 0.5}, depth) - reference.cam_from_world.translation);
         const Eigen::Vector3d normal = reference.world_from_cam * reference.Normal(x, y);
-        Eigen::Vector3d position_sum = point, normal_sum = normal, colour_sum = Eigen::Vector3d::Zero();
-        for (int c = 0; c < 3; ++c) colour_sum[c] = reference.colour.At(x, y, c);
+        Eigen::Vector3d position_sum = point, normal_sum = normal, color_sum = Eigen::Vector3d::Zero();
+        for (int c = 0; c < 3; ++c) color_sum[c] = reference.color.At(x, y, c);
         int count = 1;
         for (size_t j = 0; j < views.size(); ++j) {
           if (j == i) continue;
@@ -111,7 +111,7 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
           position_sum += other.world_from_cam *
               (*other.camera.Unproject({ox + 0.5, oy + 0.5}, other_depth) - other.cam_from_world.translation);
           normal_sum += other_normal;
-          for (int c = 0; c < 3; ++c) colour_sum[c] += static_cast<double>(other.colour.At(ox, oy, c));
+          for (int c = 0; c < 3; ++c) color_sum[c] += static_cast<double>(other.color.At(ox, oy, c));
           ++count;
         }
         if (count < options.min_views) continue;
@@ -119,8 +119,8 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
         fused.position = (position_sum / count).cast<float>();
         fused.normal = normal_sum.normalized().cast<float>();
         for (int c = 0; c < 3; ++c) {
-          const float encoded = LinearToSrgb(static_cast<float>(colour_sum[c] / count));
-          fused.colour[c] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255));
+          const float encoded = LinearToSrgb(static_cast<float>(color_sum[c] / count));
+          fused.color[c] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255));
         }
         fused.views = static_cast<uint16_t>(std::min(count, 65535));
         points.push_back(fused);
@@ -144,7 +144,7 @@ void WritePly(const fs::path& path, const std::vector<FusedPoint>& points) {
   for (const FusedPoint& point : points) {
     std::memcpy(out, point.position.data(), 3 * sizeof(float));
     std::memcpy(out + 3 * sizeof(float), point.normal.data(), 3 * sizeof(float));
-    std::memcpy(out + 6 * sizeof(float), point.colour.data(), 3);
+    std::memcpy(out + 6 * sizeof(float), point.color.data(), 3);
     out += kVertexBytes;
   }
   WriteFileAtomically(path, bytes);

@@ -26,7 +26,7 @@ struct FusionOptions {
 struct FusedPoint {
   Eigen::Vector3f position;
   Eigen::Vector3f normal;         // Unit, world frame.
-  std::array<uint8_t, 3> colour;  // sRGB.
+  std::array<uint8_t, 3> color;  // sRGB.
   uint16_t views = 0;             // How many pixels were merged.
 };
 

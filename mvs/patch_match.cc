@@ -202,8 +202,8 @@ class PatchMatcher {
   DepthNormalMap Run() {
     ForEachPixel(-1, [&](int x, int y) { Initialise(x, y); });
     for (int iteration = 0; iteration < options_.iterations; ++iteration) {
-      for (int colour = 0; colour < 2; ++colour) {
-        ForEachPixel(colour, [&](int x, int y) { Improve(x, y, iteration); });
+      for (int color = 0; color < 2; ++color) {
+        ForEachPixel(color, [&](int x, int y) { Improve(x, y, iteration); });
       }
     }
     // Keep only confident depths.
@@ -222,13 +222,13 @@ class PatchMatcher {
     Eigen::Vector3f normal;
   };
 
-  // Calls f(x, y) on every pixel of one checkerboard colour (-1: all), rows in parallel.
+  // Calls f(x, y) on every pixel of one checkerboard color (-1: all), rows in parallel.
   template <typename F>
-  void ForEachPixel(int colour, const F& f) {
+  void ForEachPixel(int color, const F& f) {
     tbb::parallel_for(tbb::blocked_range<int>(0, height_, 4), [&](const tbb::blocked_range<int>& rows) {
       for (int y = rows.begin(); y != rows.end(); ++y) {
-        const int start = colour < 0 ? 0 : (y + colour) % 2;
-        const int step = colour < 0 ? 1 : 2;
+        const int start = color < 0 ? 0 : (y + color) % 2;
+        const int step = color < 0 ? 1 : 2;
         for (int x = start; x < width_; x += step) f(x, y);
       }
     });
@@ -332,7 +332,7 @@ class PatchMatcher {
         best = candidate;
       }
     };
-    // Propagation: the neighbours' planes (of the other colour), extended to this pixel.
+    // Propagation: the neighbours' planes (of the other color), extended to this pixel.
     const int far = options_.far_neighbour_offset;
     const std::array<std::pair<int, int>, 8> offsets = {
         {{-1, 0}, {1, 0}, {0, -1}, {0, 1}, {-far, 0}, {far, 0}, {0, -far}, {0, far}}};

@@ -36,7 +36,7 @@ struct PatchMatchOptions {
   // Matching window: samples every `window_step` pixels within `window_radius` of the centre.
   int window_radius = 3;
   int window_step = 2;
-  // Red-black sweeps, each over both colours, at every pyramid level.
+  // Red-black sweeps, each over both colors, at every pyramid level.
   int iterations = 3;
   // Coarse-to-fine levels (each half the size of the next); 1 = full resolution only.
   int pyramid_levels = 3;

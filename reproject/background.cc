@@ -9,7 +9,7 @@
 namespace parallax {
 namespace {
 
-// Absolute allowance of the colour test, for dark pixels (linear light).
+// Absolute allowance of the color test, for dark pixels (linear light).
 constexpr float kDarkNoise = 0.002f;
 
 bool SimilarColor(const float* a, const float* b, float max_step) {
@@ -38,7 +38,7 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
   const int width = depth.Width();
   const int height = depth.Height();
   if (color.Width() != width || color.Height() != height || color.Channels() != 3) {
-    throw std::invalid_argument("MarkBackground: colour " + std::to_string(color.Width()) + "x" +
+    throw std::invalid_argument("MarkBackground: color " + std::to_string(color.Width()) + "x" +
                                 std::to_string(color.Height()) + "x" +
                                 std::to_string(color.Channels()) + " does not match depth " +
                                 std::to_string(width) + "x" + std::to_string(height) + "x3");
@@ -46,7 +46,7 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
   const float* rgb = color.Pixels().data();
   // A pixel next to one with depth lies on a silhouette, where the photo mixes the sky with
-  // the surface: it passes. Elsewhere, every neighbour must be of similar colour.
+  // the surface: it passes. Elsewhere, every neighbour must be of similar color.
   const auto smooth = [&](int x, int y) {
     if (max_step >= 1) return true;
     const int xs[4] = {x - 1, x + 1, x, x};

@@ -11,14 +11,14 @@
 namespace parallax {
 
 // Marks the depth-0 pixels that are 4-connected to the image border through depth-0 pixels
-// smooth in colour: in our outdoor scenes that is the sky and the far background, which a
+// smooth in color: in our outdoor scenes that is the sky and the far background, which a
 // renderer warps as directions (rotation only). A pixel is smooth when every channel of
 // `color` (linear RGB, the depth's size) is within max_step x the larger value (+ 0.002, for
 // dark noise) of each 4-neighbour's: a sky gradient is, the ground is not (pixels next to
-// one with depth pass: silhouettes mix colours). Depth-0 pixels
+// one with depth pass: silhouettes mix colors). Depth-0 pixels
 // enclosed by valid depth, or on textured ground the depth estimate missed (which touches the
 // border below the scene), are unknown, not background: they stay holes rather than land at
-// infinity. max_step >= 1 turns the colour test off. Returns one byte per pixel, row-major,
+// infinity. max_step >= 1 turns the color test off. Returns one byte per pixel, row-major,
 // 1 = background. Throws std::invalid_argument when the sizes differ.
 std::vector<uint8_t> MarkBackground(const DepthMap& depth, const Image& color, float max_step);
 // The same into *background, reusing its memory and that of *stack (scratch for the fill).
@@ -34,8 +34,8 @@ int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step);
 
 // Sets to 0 the pixels of `depth` on the near side of a depth edge: within `pixels` (4-steps)
 // of a 4-neighbour more than max_step relative depth farther away, along the near surface.
-// A photo mixes the two surfaces' colours in its edge pixels, and estimated depth puts them on
-// the near surface (foreground fattening): warped, they draw a halo of the background colour
+// A photo mixes the two surfaces' colors in its edge pixels, and estimated depth puts them on
+// the near surface (foreground fattening): warped, they draw a halo of the background color
 // around every occluder. Without them the near surface stops a pixel short and the other
 // sources (or the fill) give the background there. Returns how many values were cleared.
 // Throws std::invalid_argument for max_step <= 0 or pixels < 0.

@@ -25,11 +25,11 @@ using simd::Store4;
 struct RowSums {
   const float* front;  // Front-most surface depth; +inf: none.
   const float* limit;  // Samples up to this depth join.
-  float* rgbw;         // Weighted colour (RGB) and weight (W) per pixel, interleaved.
+  float* rgbw;         // Weighted color (RGB) and weight (W) per pixel, interleaved.
   float* depth;
 };
 
-// A pixel's colour and weight (RGBW) added to its sums (colour times weight, and weight)
+// A pixel's color and weight (RGBW) added to its sums (color times weight, and weight)
 // where `take` (all lanes alike).
 void AddPixel(F4 rgbw, I4 take, float* sums) {
   const F4 w = __builtin_shufflevector(rgbw, rgbw, 3, 3, 3, 3);
@@ -42,7 +42,7 @@ void AddPixel(F4 rgbw, I4 take, float* sums) {
 // depth only where the front holds a surface. `color_weight`: WarpBuffer::ColorWeights.
 void AddSamples(const float* depth, const uint16_t* color_weight, size_t width,
                 const RowSums& sums) {
-  // Colour and weight are read here first, a stream per buffer next to the others' and the
+  // Color and weight are read here first, a stream per buffer next to the others' and the
   // sums: the hardware prefetcher fell behind (blend 12.8 -> 10.5 ms at 1920x1080, 1.55 ->
   // 1.30 ms at 640x480 inside the K=4 render, with floats). Asked for kAhead pixels ahead,
   // a cache line (8 pixels) at a time.
@@ -53,7 +53,7 @@ void AddSamples(const float* depth, const uint16_t* color_weight, size_t width,
     const F4 d = Load4(depth + x);
     const I4 take = (d > 0) & (d <= Load4(sums.limit + x));
     if (LaneBits(take) == 0) continue;
-    // Colour and weight are written only where a sample landed: lanes not taken may hold
+    // Color and weight are written only where a sample landed: lanes not taken may hold
     // anything, and are selected away, never added.
     const uint16_t* samples = color_weight + 4 * x;
     const F4 rgbw[4] = {simd::LoadHalf4(samples), simd::LoadHalf4(samples + 4),

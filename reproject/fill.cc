@@ -28,10 +28,10 @@ bool ShouldFill(PixelClass c, const FillOptions& options) {
   return IsHole(c) || (options.fill_out_of_view && c == PixelClass::kOutOfView);
 }
 
-// The colour of the background at infinity as an affine function of the target pixel's unit
+// The color of the background at infinity as an affine function of the target pixel's unit
 // viewing ray, fitted by least squares to the pixels where background landed. Background is
 // a function of direction alone, so where no source saw the sky (out of view above the
-// sources' frames) this extrapolates its gradient instead of smearing the colour of its edge:
+// sources' frames) this extrapolates its gradient instead of smearing the color of its edge:
 // on the courtyard's upward-looking novel view, 0.076 -> 0.056 RMS on the out-of-view upper
 // half (a linear model overshoots a sky that saturates towards the zenith; quadratic ones
 // were unstable).
@@ -75,7 +75,7 @@ class SkyModel {
     rhs.bottomRows<3>() = sum.ray_rgb - mean_ray_ * sum.rgb.transpose();
     for (int c = 0; c < 3; ++c) max_[c] = std::max(max_[c], static_cast<float>(sum.max[c]));
     // A ridge on the gradient: over a patch of sky narrower than ~kMinSpreadRad the gradient
-    // is not determined and the model stays close to the patch's mean colour.
+    // is not determined and the model stays close to the patch's mean color.
     for (int k = 1; k < 4; ++k) normal(k, k) += count * kMinSpreadRad * kMinSpreadRad;
     coefficients_ = normal.ldlt().solve(rhs);
     valid_ = coefficients_.allFinite();
@@ -84,7 +84,7 @@ class SkyModel {
   // False when too little background landed to fit (then FillPixel averages neighbours).
   bool Valid() const { return valid_; }
 
-  // Colour at pixel (x, y), clamped to [0, max(1, brightest fitted value)] per channel (far
+  // Color at pixel (x, y), clamped to [0, max(1, brightest fitted value)] per channel (far
   // outside the fitted rays a linear model can run away; photos are at most 1).
   void ColorAt(int x, int y, float rgb[3]) const {
     const Eigen::Vector3d d = Ray(x, y) - mean_ray_;
@@ -98,7 +98,7 @@ class SkyModel {
   static constexpr int kMinSamples = 64;
   static constexpr double kMinSpreadRad = 0.01;
 
-  // Sums over background samples of their unit rays and colours.
+  // Sums over background samples of their unit rays and colors.
   struct Moments {
     int count = 0;
     Eigen::Vector3d ray = Eigen::Vector3d::Zero();
@@ -199,7 +199,7 @@ class DepthAwareFiller {
       const float depth = candidate->depth;
       if (std::isinf(depth)) {
         // Background is the farthest of all, and where it is taken the sky model alone gives
-        // the colour: the other directions cannot change the result.
+        // the color: the other directions cannot change the result.
         if (++skies >= sky_directions && sky_.Valid()) {
           WriteBackground(x, y);
           return true;
@@ -245,7 +245,7 @@ class DepthAwareFiller {
     return static_cast<size_t>(y) * static_cast<size_t>(width_) + static_cast<size_t>(x);
   }
 
-  // The sky model's colour at (x, y), with depth 0 (background at infinity).
+  // The sky model's color at (x, y), with depth 0 (background at infinity).
   void WriteBackground(int x, int y) {
     const size_t i = Index(x, y);
     sky_.ColorAt(x, y, blend_.color.Pixels().data() + 3 * i);

@@ -37,9 +37,9 @@ struct FillOptions {
 };
 
 struct FillSummary {
-  int filled_px = 0;  // Pixels that received a colour.
-  // Share of all pixels still without colour after filling (holes nothing reached, and
-  // out-of-view pixels when they are not filled). 0 when everything got a colour.
+  int filled_px = 0;  // Pixels that received a color.
+  // Share of all pixels still without color after filling (holes nothing reached, and
+  // out-of-view pixels when they are not filled). 0 when everything got a color.
   double hole_ratio_filled = 0;
   // Why filling was left out, when it was (nothing to fill); empty when it ran.
   std::string skipped;
@@ -49,9 +49,9 @@ struct FillSummary {
 // fill_out_of_view). kDepthAware scans `directions` rays from the pixel to the nearest pixel
 // with a sample, keeps the candidates whose depth is the farthest (background at infinity
 // counts as farthest, except for holes: see hole_sky_share) within background_tolerance, and
-// averages their colours weighted by inverse distance; surface fills also get that averaged
-// depth. A disocclusion is hidden background, so its colour comes from the background side,
-// not from the occluder. Where the background side is background at infinity, the colour
+// averages their colors weighted by inverse distance; surface fills also get that averaged
+// depth. A disocclusion is hidden background, so its color comes from the background side,
+// not from the occluder. Where the background side is background at infinity, the color
 // comes from a sky model instead: an affine function of the viewing ray through `camera` (the
 // target's), fitted to the pixels where background landed, so sky nothing saw continues the
 // gradient of the sky around it.

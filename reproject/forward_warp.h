@@ -16,7 +16,7 @@ enum class WarpMethod {
   kSplat,  // Each source pixel drawn as a square footprint sized by its local magnification.
   kMesh,   // Two triangles per 2x2 quad of source pixel centres, perspective-correct; flat
            // 8x8, 4x4 or 2x2 blocks of one surface (or of background) as one quad through the
-           // projective map of its corners, the colour sampled from the source at the mapped
+           // projective map of its corners, the color sampled from the source at the mapped
            // source position (TextureFilter).
 };
 
@@ -37,15 +37,15 @@ struct ForwardWarpOptions {
   // Points are dropped when their target z is below this share of their distance from the
   // target centre (at or behind the camera plane, or projecting absurdly far out); in (0, 1).
   double min_view_cos = 1e-6;
-  // Depth-0 source pixels connected to the border through smooth colour (MarkBackground) are
+  // Depth-0 source pixels connected to the border through smooth color (MarkBackground) are
   // warped as directions and land as background at infinity; when false every depth-0 pixel
   // is unknown.
   bool background_at_infinity = true;
-  // MarkBackground's colour test: the largest relative step between neighbouring background
+  // MarkBackground's color test: the largest relative step between neighbouring background
   // pixels (>= 1: no test). The sky's steps are well below 1%; textured ground the depth
   // stage missed has larger ones and stays unknown instead of being warped to infinity.
   double background_max_step = 0.05;
-  // Mesh: colour sampling of the source. kAuto: Catmull-Rom where the target magnifies the source
+  // Mesh: color sampling of the source. kAuto: Catmull-Rom where the target magnifies the source
   // (more than 1.5 target pixels per source pixel), bilinear elsewhere. kBicubic: Catmull-Rom
   // everywhere, sharper where a sample falls between source pixels, at some extra warp time.
   TextureFilter texture_filter = TextureFilter::kAuto;
@@ -54,7 +54,7 @@ struct ForwardWarpOptions {
   double angle_epsilon_rad = 0.01;
   // Mesh: added to the ray angle of samples on a silhouette (a surface pixel beside a depth
   // edge, sky or unknown depth; radians, >= 0): the photo mixes the two sides there, and a
-  // source that sees the point away from its silhouettes has its pure colour. 0 turns it off.
+  // source that sees the point away from its silhouettes has its pure color. 0 turns it off.
   double silhouette_angle_rad = 0.5;
   // Mesh: a surface sample on the near side of a depth edge (beside a farther surface, sky or
   // unknown depth) is splatted at this share of its footprint, and one on the far side at
@@ -102,14 +102,14 @@ class WarpBuffer {
   // to [kMinWeight, kMaxHalf]. One number computed by the warp rather than angle and stretch
   // for the blend to combine: less to write and read back.
   float Weight(size_t i) const;
-  // Colour and weight of each pixel as four IEEE half floats (R, G, B, weight; simd.h's
+  // Color and weight of each pixel as four IEEE half floats (R, G, B, weight; simd.h's
   // StoreHalf4): 8 bytes per sample instead of 16 in floats. The warps write them and the
   // blend reads them all, and the render core waits on memory (half the bytes to move).
   // A half keeps 11 significant bits, 20 times finer than an 8-bit sRGB step anywhere;
-  // colour saturates at kMaxHalf.
+  // color saturates at kMaxHalf.
   const uint16_t* ColorWeights() const { return color_weight_.get(); }  // 4 Size() of them.
 
-  // The relative rounding of a colour or weight stored in a half (11 significant bits).
+  // The relative rounding of a color or weight stored in a half (11 significant bits).
   static constexpr double kHalfRounding = 0x1p-11;
   // The largest finite half float, and the smallest normal one: the weight's clamp, so that
   // it keeps its relative precision and never rounds to 0 or infinity.
@@ -138,7 +138,7 @@ class WarpScratch {
 
   struct Data;  // Defined in forward_warp.cc.
   Data& Get() { return *data_; }
-  // MarkBackground of the last warped source's depth and colour (the warp's own, or the
+  // MarkBackground of the last warped source's depth and color (the warp's own, or the
   // source's own mask, which lives as long as the source); empty when the warp did not use
   // background at infinity.
   const std::vector<uint8_t>& Background() const;
@@ -148,9 +148,9 @@ class WarpScratch {
 };
 
 // Makes what every warp of the source would otherwise make again, for the warps to share:
-// source->texture, and source->background (MarkBackground of its depth and colour, with the
+// source->texture, and source->background (MarkBackground of its depth and color, with the
 // options' background_max_step) where the options warp background at infinity. Call again
-// whenever the depth or colour changes. Throws std::invalid_argument for a source
+// whenever the depth or color changes. Throws std::invalid_argument for a source
 // CheckSourceView refuses or bad options.
 void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {});
 

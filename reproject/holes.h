@@ -87,7 +87,7 @@ struct ClassifySource {
   PosedCamera camera;
   // Its depth map (camera size); null: only its frustum is known (no free-space test).
   const DepthMap* depth = nullptr;
-  // MarkBackground of `depth` and the source's colour (background at infinity, seen as empty
+  // MarkBackground of `depth` and the source's color (background at infinity, seen as empty
   // space at every depth; marks where the depth is not 0 are ignored);
   // null or empty: every depth-0 pixel is unknown.
   const std::vector<uint8_t>* background = nullptr;

@@ -31,7 +31,7 @@ struct Corner {
   float sx, sy;  // Source pixel (column, row) whose centre this is.
 };
 
-// Colour channels (RGB and one more) side by side.
+// Color channels (RGB and one more) side by side.
 using simd::F4;
 using simd::LoadHalf4;
 
@@ -133,7 +133,7 @@ class Rasterizer {
  public:
   // Draws only target rows [row_begin, row_end): rasterisers of disjoint row bands may share
   // one buffer from different threads.
-  // `texture`: the source's colour as SourceView::texture holds it (half floats, RGBA),
+  // `texture`: the source's color as SourceView::texture holds it (half floats, RGBA),
   // texture_width x texture_height pixels.
   Rasterizer(WarpBuffer* buffer, const uint16_t* texture, int texture_width, int texture_height,
              const ForwardWarpOptions& options, int row_begin, int row_end)
@@ -162,7 +162,7 @@ class Rasterizer {
   }
 
   // A square block of `side` x `side` source pixels of one continuous surface (or of
-  // background, kBackground), corners a (top left), b, c, d (bottom right), its colour sampled
+  // background, kBackground), corners a (top left), b, c, d (bottom right), its color sampled
   // from the source at the position BlockMap gives (so a block larger than one pixel keeps
   // the texture's detail). Returns false, drawing nothing, where the map is not defined
   // (BlockMap::Init): the caller draws the block another way.
@@ -354,7 +354,7 @@ class Rasterizer {
     StoreColorWeight(i, rgbw);
   }
 
-  // Colour (RGB) and weight of target pixel i, in WarpBuffer::ColorWeights' halves.
+  // Color (RGB) and weight of target pixel i, in WarpBuffer::ColorWeights' halves.
   void StoreColorWeight(size_t i, F4 rgbw) {
     constexpr float kMax = WarpBuffer::kMaxHalf;
     StoreHalf4Clamped(color_weight_ + 4 * i, rgbw, F4{-kMax, -kMax, -kMax, WarpBuffer::kMinWeight});
@@ -370,7 +370,7 @@ class Rasterizer {
   // Writes the lanes of a group of kLanes pixels (target pixels i to i + kLanes - 1 of one
   // row, `left` of them before the row ends) that a block covers (`in`, at source positions
   // fx, fy relative to corner a's, `w` of its map) and that pass the z-test: depth and weight
-  // for all lanes at once, then the colour of each written lane, sampled from the source.
+  // for all lanes at once, then the color of each written lane, sampled from the source.
   template <bool kBackground>
   void WriteGroup(size_t i, int left, IV in, FV fx, FV fy, FV w, const BlockMap& map,
                   const Corner& a) {
@@ -453,7 +453,7 @@ class Rasterizer {
     return t;
   }
 
-  // The colour at lane k of `taps` (lane 3 is 0).
+  // The color at lane k of `taps` (lane 3 is 0).
   F4 Bilinear(const Taps& taps, int k) const {
     const size_t row = static_cast<size_t>(taps.y0[k]) * static_cast<size_t>(texture_width_);
     const uint16_t* t00 = texture_ + 4 * (row + static_cast<size_t>(taps.x0[k]));

@@ -79,7 +79,7 @@ class Renderer {
   std::vector<WarpScratch> scratch_;
   std::vector<const SourceView*> sources_;  // Of the last render.
   TargetCamera target_;
-  // The frame being blended and filled; its colour and depth then trade places with the
+  // The frame being blended and filled; its color and depth then trade places with the
   // result's, whose memory (the caller's last frame) the next frame is blended into.
   BlendResult blend_;
 };

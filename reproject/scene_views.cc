@@ -15,7 +15,7 @@ Image LinearRgb(const Image& encoded) {
   for (int y = 0; y < linear.Height(); ++y) {
     for (int x = 0; x < linear.Width(); ++x) {
       for (int c = 0; c < 3; ++c) {
-        // Grey (1 or 2 channels) repeats its only colour channel.
+        // Grey (1 or 2 channels) repeats its only color channel.
         rgb.At(x, y, c) = linear.At(x, y, linear.Channels() >= 3 ? c : 0);
       }
     }

@@ -66,7 +66,7 @@ inline F4 Load4(const float* p) { return Load<F4>(p); }
 inline void Store4(float* p, F4 value) { Store(p, value); }
 
 // Four floats as IEEE half floats (binary16, rounded to nearest even; 8 bytes), and back: the
-// warp buffers' colour and weight. Portable integer arithmetic here; with F16C (x86-64-v3)
+// warp buffers' color and weight. Portable integer arithmetic here; with F16C (x86-64-v3)
 // StoreHalf4 and LoadHalf4 below use its instructions, with the same results (NaN payloads
 // aside).
 using U4 = uint32_t __attribute__((vector_size(16)));

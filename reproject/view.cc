@@ -39,14 +39,14 @@ void CheckSourceView(const SourceView& view) {
   const std::string name = "source view '" + view.name + "'";
   const Pinhole pinhole = Pinhole::From(view.camera);
   if (view.color.Channels() != 3) {
-    throw std::invalid_argument(name + ": colour must have 3 channels, got " +
+    throw std::invalid_argument(name + ": color must have 3 channels, got " +
                                 std::to_string(view.color.Channels()));
   }
   const auto size = [](int w, int h) { return std::to_string(w) + "x" + std::to_string(h); };
   if (view.color.Width() != pinhole.width || view.color.Height() != pinhole.height ||
       view.depth.Width() != pinhole.width || view.depth.Height() != pinhole.height) {
     throw std::invalid_argument(name + ": camera " + size(pinhole.width, pinhole.height) +
-                                ", colour " + size(view.color.Width(), view.color.Height()) +
+                                ", color " + size(view.color.Width(), view.color.Height()) +
                                 " and depth " + size(view.depth.Width(), view.depth.Height()) +
                                 " must have the same size");
   }

@@ -7,7 +7,7 @@
 //  - Cameras are pinhole (PINHOLE or SIMPLE_PINHOLE, or a distortion model whose distortion
 //    parameters are all 0): workspace images are undistorted. Anything else throws
 //    std::invalid_argument.
-//  - Colours are linear-light float RGB in memory; callers convert sRGB with core/image.h.
+//  - Colors are linear-light float RGB in memory; callers convert sRGB with core/image.h.
 //  - No NaN or Inf ever leaves a function: divisions are guarded and results checked finite.
 #include <cstdint>
 #include <string>
@@ -34,14 +34,14 @@ struct SourceView {
   Rigid3d cam_from_world;
   Image color;     // Linear RGB, 3 channels, camera size.
   DepthMap depth;  // z-depth in scene units, 0 = no value; camera size.
-  // Made once per source by PrepareSource (forward_warp.h), after the depth and colour are
+  // Made once per source by PrepareSource (forward_warp.h), after the depth and color are
   // final, instead of by every warp; when empty (or made with another step, or for another
   // size), ForwardWarp makes its own.
-  // Which depth-0 pixels are background at infinity: MarkBackground of depth and colour with
+  // Which depth-0 pixels are background at infinity: MarkBackground of depth and color with
   // background_step.
   std::vector<uint8_t> background;
   float background_step = 0;
-  // The colour as the warp samples it: four half floats per pixel (R, G, B, 0), 8 bytes to
+  // The color as the warp samples it: four half floats per pixel (R, G, B, 0), 8 bytes to
   // stream instead of 12 (the warps wait on this memory), one aligned load per tap.
   std::vector<uint16_t> texture;
 
@@ -67,8 +67,8 @@ struct Pinhole {
   }
 };
 
-// Throws std::invalid_argument naming the view when the camera is not pinhole, the colour is
-// not 3-channel, or colour, depth and camera sizes differ.
+// Throws std::invalid_argument naming the view when the camera is not pinhole, the color is
+// not 3-channel, or color, depth and camera sizes differ.
 void CheckSourceView(const SourceView& view);
 
 }  // namespace parallax

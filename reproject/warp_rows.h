@@ -58,7 +58,7 @@ void ContinuousRow(const SourceView& source, const WarpSetup& s, int y, Vertices
 
 // Adds `penalty` to the ray angle (so to the blend weight's denominator) of the surface
 // vertices of source row y beside a dropped quad (quads: ContinuousRow's, complete): those
-// pixels lie on a silhouette, or next to sky or unknown depth, and their photo colour mixes
+// pixels lie on a silhouette, or next to sky or unknown depth, and their photo color mixes
 // the two sides, where another source that sees the point away from its silhouettes has it
 // pure. Quads outside the image do not count (the image border is no silhouette).
 void PenaliseSilhouetteRow(const WarpSetup& s, float penalty, int y, uint8_t* marks_row,

@@ -43,7 +43,7 @@ struct WorkspaceDepthPreparation {
 // its depth (Embree, one ray per pixel): estimated depth maps lack depth where matching
 // failed; last, edge_erosion_px pixels of the near side of
 // every depth edge are dropped (ErodeDepthEdges): window-based stereo fattens occluders, and
-// their edge pixels mix in the background's colour. Ground-truth depth is used as it is.
+// their edge pixels mix in the background's color. Ground-truth depth is used as it is.
 WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& workspace,
                                                 const NovelViewSettings& settings,
                                                 SourceLibrary* library);

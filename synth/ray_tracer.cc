@@ -301,7 +301,7 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
 
   std::vector<float> light_visible(num_lights);
   for (int x = 0; x < width; ++x) {
-    Eigen::Vector3f colour = Eigen::Vector3f::Zero();
+    Eigen::Vector3f color = Eigen::Vector3f::Zero();
     for (int s = 0; s < per_pixel; ++s) {
       const size_t i = static_cast<size_t>(x) * per_pixel + s;
       const SurfaceSample& surface = surfaces[i];
@@ -318,10 +318,10 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
         light_visible[l] = shadow_rays[i * num_lights + l].tfar >= 0 ? 1.0f : 0.0f;
       }
       const Eigen::Vector3d direction(rays[i].ray.dir_x, rays[i].ray.dir_y, rays[i].ray.dir_z);
-      colour += surface.hit ? Shade(surface, light_visible.data()) : SkyColor(scene.sky, direction);
+      color += surface.hit ? Shade(surface, light_visible.data()) : SkyColor(scene.sky, direction);
     }
-    colour /= static_cast<float>(samples * samples);
-    for (int c = 0; c < 3; ++c) view.color.At(x, y, c) = colour[c];
+    color /= static_cast<float>(samples * samples);
+    for (int c = 0; c < 3; ++c) view.color.At(x, y, c) = color[c];
   }
 }
 

@@ -83,7 +83,7 @@ class Node {
   }
   Eigen::Vector3f Color(const std::string& key, const Eigen::Vector3f& fallback) const {
     const Eigen::Vector3d color = Vec3(key, fallback.cast<double>());
-    if ((color.array() < 0).any()) Fail("field '" + key + "' must be a non-negative colour");
+    if ((color.array() < 0).any()) Fail("field '" + key + "' must be a non-negative color");
     return color.cast<float>();
   }
 
@@ -129,7 +129,7 @@ TextureDesc ParseTexture(const Node& node) {
                                          {"checker", TextureType::kChecker}});
   if (node.Has("colors")) {
     const Json& colors = node.Array("colors");
-    if (colors.size() != 2) node.Fail("colors must hold two colours");
+    if (colors.size() != 2) node.Fail("colors must hold two colors");
     const Json pair = Json{{"a", colors[0]}, {"b", colors[1]}};
     const Node pair_node(pair, node.Key("colors"), node.Source());
     texture.color_a = pair_node.Color("a", Eigen::Vector3f::Zero());

@@ -14,8 +14,8 @@
 namespace parallax {
 
 enum class TextureType {
-  kFbm,      // Multi-scale 3D value noise between two colours.
-  kChecker,  // 3D checker of two colours, modulated by fine noise.
+  kFbm,      // Multi-scale 3D value noise between two colors.
+  kChecker,  // 3D checker of two colors, modulated by fine noise.
 };
 
 struct TextureDesc {
@@ -24,7 +24,7 @@ struct TextureDesc {
   Eigen::Vector3f color_b{0.8f, 0.8f, 0.8f};  // Linear RGB.
   float scale = 1;       // Largest feature size (fbm) or cell size (checker), scene units.
   int octaves = 6;       // Noise octaves, each half the size of the previous.
-  float contrast = 1.5f; // > 1 pushes noise towards the two colours.
+  float contrast = 1.5f; // > 1 pushes noise towards the two colors.
   uint32_t seed = 0;
 };
 
@@ -66,7 +66,7 @@ struct ImageDesc {
   int width = 320;
   int height = 240;
   double focal_px = 300;
-  int supersampling = 2;  // s x s samples per pixel for colour; depth at the pixel centre.
+  int supersampling = 2;  // s x s samples per pixel for color; depth at the pixel centre.
 };
 
 struct ViewDesc {

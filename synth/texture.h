@@ -1,6 +1,6 @@
 #pragma once
-// Procedural solid textures: colour as a function of the 3D surface point, so every object is
-// textured without UV coordinates and every view of a point sees the same colour.
+// Procedural solid textures: color as a function of the 3D surface point, so every object is
+// textured without UV coordinates and every view of a point sees the same color.
 #include <Eigen/Core>
 
 #include "synth/scene.h"

@@ -20,7 +20,7 @@ void SetVertexLayout() {
   attribute(0, 3, offsetof(Vertex, position));
   attribute(1, 3, offsetof(Vertex, normal));
   attribute(2, 2, offsetof(Vertex, uv));
-  attribute(3, 3, offsetof(Vertex, colour));
+  attribute(3, 3, offsetof(Vertex, color));
 }
 
 // The mesh's positions, shared between triangles and drawn by index, for depth-only passes
@@ -124,7 +124,7 @@ IndexedMesh UploadShadedMesh(const TriangleMesh& mesh) {
 }
 
 // The planar shadow casters' mesh: three vertices per triangle, each with its face normal and
-// its corner's atlas coordinate (t = 1 - v: the atlas is uploaded top row first). colour.x of a
+// its corner's atlas coordinate (t = 1 - v: the atlas is uploaded top row first). color.x of a
 // mesh vertex holds its triangle's greatest height above the ground, so planar shadows can drop
 // the ground's own triangles without also dropping the foot of a wall.
 std::vector<Vertex> MeshVertices(const TriangleMesh& mesh, const std::optional<GroundPlane>& ground) {
@@ -237,7 +237,7 @@ void EyeTarget::Resize(int new_width, int new_height) {
   if (width == new_width && height == new_height && framebuffer.Get() != 0) return;
   width = new_width;
   height = new_height;
-  colour = MakeTextureOnScratchUnit();
+  color = MakeTextureOnScratchUnit();
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
   SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
   aux = MakeTextureOnScratchUnit();
@@ -248,7 +248,7 @@ void EyeTarget::Resize(int new_width, int new_height) {
   glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, width, height);
   framebuffer = MakeGlFramebuffer();
   glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour.Get(), 0);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, color.Get(), 0);
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, aux.Get(), 0);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
                             depth_stencil.Get());

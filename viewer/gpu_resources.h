@@ -24,7 +24,7 @@ struct Vertex {
   float position[3];
   float normal[3];
   float uv[2];
-  float colour[3];
+  float color[3];
 };
 
 // A vertex array over `vertices` with the attribute layout of the shaders.
@@ -70,10 +70,10 @@ struct DepthTarget {
   void Resize(int new_width, int new_height);
 };
 
-// The frame: sRGB-encoded colour (RGBA8), auxiliary float RGBA, float depth + stencil.
+// The frame: sRGB-encoded color (RGBA8), auxiliary float RGBA, float depth + stencil.
 struct EyeTarget {
   GlFramebuffer framebuffer;
-  GlTexture colour, aux;
+  GlTexture color, aux;
   GlRenderbuffer depth_stencil;
   int width = 0, height = 0;
 

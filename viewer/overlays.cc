@@ -20,30 +20,30 @@ double NiceStep(double minimum) {
 }
 
 void AddLine(std::vector<Vertex>& lines, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-             const Eigen::Vector3f& colour) {
+             const Eigen::Vector3f& color) {
   for (const Eigen::Vector3d& p : {a, b}) {
     lines.push_back({{static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())},
-                     {0, 0, 0}, {0, 0}, {colour.x(), colour.y(), colour.z()}});
+                     {0, 0, 0}, {0, 0}, {color.x(), color.y(), color.z()}});
   }
 }
 
 }  // namespace
 
-std::vector<gpu::Vertex> PointVertices(const std::vector<ColouredPoint>& points) {
+std::vector<gpu::Vertex> PointVertices(const std::vector<ColoredPoint>& points) {
   std::vector<Vertex> vertices;
   vertices.reserve(points.size());
-  for (const ColouredPoint& p : points) {
+  for (const ColoredPoint& p : points) {
     vertices.push_back({{p.position.x(), p.position.y(), p.position.z()},
                         {p.normal.x(), p.normal.y(), p.normal.z()},
                         {0, 0},
-                        {p.colour[0] / 255.0f, p.colour[1] / 255.0f, p.colour[2] / 255.0f}});
+                        {p.color[0] / 255.0f, p.color[1] / 255.0f, p.color[2] / 255.0f}});
   }
   return vertices;
 }
 
 std::vector<gpu::Vertex> FrustumLines(const std::vector<ViewerSource>& sources, double depth) {
   std::vector<Vertex> lines;
-  const Eigen::Vector3f colour(0.9f, 0.45f, 0.1f);
+  const Eigen::Vector3f color(0.9f, 0.45f, 0.1f);
   for (const ViewerSource& source : sources) {
     const Rigid3d world_from_cam = source.cam_from_world.Inverse();
     const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
@@ -56,11 +56,11 @@ std::vector<gpu::Vertex> FrustumLines(const std::vector<ViewerSource>& sources, 
       corners[i] = world_from_cam * (depth * ray);
     }
     for (int i = 0; i < 4; ++i) {
-      AddLine(lines, centre, corners[i], colour);
-      AddLine(lines, corners[i], corners[(i + 1) % 4], colour);
+      AddLine(lines, centre, corners[i], color);
+      AddLine(lines, corners[i], corners[(i + 1) % 4], color);
     }
     const Eigen::Vector3d top = 0.5 * (corners[0] + corners[1]);
-    AddLine(lines, top, top + 0.3 * (top - 0.5 * (corners[2] + corners[3])), colour);
+    AddLine(lines, top, top + 0.3 * (top - 0.5 * (corners[2] + corners[3])), color);
   }
   return lines;
 }
@@ -115,11 +115,11 @@ std::vector<gpu::Vertex> GridLines(const ViewerScene& scene) {
             (std::round(v.dot(origin) / step) * step - v.dot(origin)) * v;
   const double extent = (cells + 1) * step;
   std::vector<Vertex> lines;
-  const Eigen::Vector3f colour(0.55f, 0.55f, 0.55f);
+  const Eigen::Vector3f color(0.55f, 0.55f, 0.55f);
   for (int i = -cells - 1; i <= cells + 1; ++i) {
     const double s = i * step;
-    AddLine(lines, origin + s * u - extent * v, origin + s * u + extent * v, colour);
-    AddLine(lines, origin - extent * u + s * v, origin + extent * u + s * v, colour);
+    AddLine(lines, origin + s * u - extent * v, origin + s * u + extent * v, color);
+    AddLine(lines, origin - extent * u + s * v, origin + extent * u + s * v, color);
   }
   return lines;
 }

@@ -12,7 +12,7 @@ namespace parallax {
 // and a tick on its top edge.
 constexpr int kFrustumVertices = 18;
 
-std::vector<gpu::Vertex> PointVertices(const std::vector<ColouredPoint>& points);
+std::vector<gpu::Vertex> PointVertices(const std::vector<ColoredPoint>& points);
 
 // Each source camera as a pyramid from its centre to its image corners at `depth`, with a
 // tick on the top edge so "up" is visible: kFrustumVertices line vertices per camera, in order.

@@ -263,7 +263,7 @@ void SceneRenderer::Impl::UseSurfaceProgram(const GlProgram& program, const View
   program.Set("u_cam_from_world", ViewMatrix(view.cam_from_world));
   program.Set("u_eye", Eigen::Vector3f(CameraCenter(view.cam_from_world).cast<float>()));
   program.Set("u_light", Eigen::Vector4f(LightVector(settings.light).cast<float>()));
-  program.Set("u_light_colour", Eigen::Vector3f(settings.light.intensity * settings.light.colour));
+  program.Set("u_light_color", Eigen::Vector3f(settings.light.intensity * settings.light.color));
   program.Set("u_ambient", settings.ambient);
   program.Set("u_specular", settings.specular);
   program.Set("u_shininess", settings.shininess);
@@ -414,9 +414,9 @@ void SceneRenderer::Impl::BeginFrame(int width, int height, const FrameSettings&
   glViewport(0, 0, width, height);
   const Eigen::Vector3f background(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
                                    LinearToSrgb(settings.background.z()));
-  const float clear_colour[4] = {background.x(), background.y(), background.z(), 1};
+  const float clear_color[4] = {background.x(), background.y(), background.z(), 1};
   const float clear_aux[4] = {1, 0, 0, 0};
-  glClearBufferfv(GL_COLOR, 0, clear_colour);
+  glClearBufferfv(GL_COLOR, 0, clear_color);
   // The auxiliary target is read back by Render alone: a frame for the window (or a timing)
   // leaves it out, which saves llvmpipe 16 bytes a pixel written, about 13% of a frame.
   const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
@@ -523,7 +523,7 @@ FrameResult SceneRenderer::Render(const ViewCamera& view, const FrameSettings& s
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
     for (int x = 0; x < width; ++x) {
-      for (int c = 0; c < 3; ++c) result.colour.At(x, y, c) = bytes[(row + x) * 4 + c] / 255.0f;
+      for (int c = 0; c < 3; ++c) result.color.At(x, y, c) = bytes[(row + x) * 4 + c] / 255.0f;
       for (int c = 0; c < 4; ++c) result.aux.At(x, y, c) = aux[(row + x) * 4 + c];
     }
   }

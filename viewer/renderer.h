@@ -1,6 +1,6 @@
 #pragma once
 // The OpenGL renderer of the viewer: one code path for the window and for offscreen images.
-// Every frame is drawn into the renderer's own framebuffer (sRGB-encoded colour, a float
+// Every frame is drawn into the renderer's own framebuffer (sRGB-encoded color, a float
 // auxiliary target, 32-bit float depth + stencil); the window blits it to the screen, the
 // offscreen path reads it back.
 //
@@ -28,7 +28,7 @@ enum class ShadowMode {
 };
 
 enum class TextureMode {
-  kAtlas,       // The mesh's texture atlas (points: their colours), lit.
+  kAtlas,       // The mesh's texture atlas (points: their colors), lit.
   kProjective,  // Source photos projected from their cameras, shown as captured.
   kShaded,      // Uniform grey albedo, lit: shows the geometry and the shadows.
 };
@@ -39,7 +39,7 @@ struct LightSettings {
   LightKind type = LightKind::kDirectional;
   Eigen::Vector3d direction = Eigen::Vector3d(-0.4, -0.3, -0.87);  // Directional: travel direction (world).
   Eigen::Vector3d position = Eigen::Vector3d::Zero();              // Point light (world).
-  Eigen::Vector3f colour{1, 1, 1};  // Linear RGB.
+  Eigen::Vector3f color{1, 1, 1};  // Linear RGB.
   float intensity = 1;  // Irradiance (directional) or intensity (point, falls off as 1/d^2).
 };
 
@@ -50,7 +50,7 @@ struct FrameSettings {
   float ambient = 0.2f;           // Ambient irradiance, linear.
   float specular = 0.15f;         // Blinn-Phong specular weight.
   float shininess = 32;           // Blinn-Phong exponent.
-  float exposure_stops = 0;       // Linear colour is scaled by 2^stops before sRGB encoding.
+  float exposure_stops = 0;       // Linear color is scaled by 2^stops before sRGB encoding.
   int shadow_map_size = 2048;     // Shadow map side in texels, 64..8192.
   int pcf_radius = 1;             // PCF kernel radius in texels (kernel 2r+1 square), 0..4.
   int projective_views = 3;       // Source photos blended in projective mode, 1..3.
@@ -73,7 +73,7 @@ struct ViewCamera {
 };
 
 struct FrameResult {
-  Image colour;  // sRGB-encoded RGB, top row first.
+  Image color;  // sRGB-encoded RGB, top row first.
   // Per pixel: light visibility in [0, 1] (1 lit; shadow map/PCF/planar), n.l (the normal
   // turned towards the eye), eye z-depth, coverage (1 where a surface was drawn).
   Image aux;

@@ -74,8 +74,8 @@ Screenshot TakeScreenshot(const ViewerScene& scene, const FrameSettings& setting
   shot.frame = renderer.Render(shot.view, settings);
   shot.ms = MsSince(start);
   shot.notes = renderer.TakeNotes();
-  WriteImage(options.path, shot.frame.colour, PixelFormat::kUint8);  // Atomic: temporary + rename.
-  shot.drawn = &DisplayedMesh(scene, shot.frame.colour.Width(), shot.frame.colour.Height());
+  WriteImage(options.path, shot.frame.color, PixelFormat::kUint8);  // Atomic: temporary + rename.
+  shot.drawn = &DisplayedMesh(scene, shot.frame.color.Width(), shot.frame.color.Height());
   shot.display_mesh = shot.drawn == &scene.display_mesh;
   if (options.timed_frames > 0) shot.times = TimeFrames(renderer, shot.view, settings, options.timed_frames);
   return shot;

@@ -6,14 +6,14 @@ const char* const kSurfaceVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_uv;
-layout(location = 3) in vec3 a_colour;  // sRGB in [0, 1] (points); unused for the mesh.
+layout(location = 3) in vec3 a_color;  // sRGB in [0, 1] (points); unused for the mesh.
 uniform mat4 u_clip_from_world;
 uniform mat4 u_cam_from_world;
 uniform float u_point_size;
 out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
-out vec3 v_colour;
+out vec3 v_color;
 out float v_eye_depth;
 // The shadow map's clip coordinates are linear in the position: interpolated, not computed per
 // pixel (the link drops them from programs without a shadow map).
@@ -24,7 +24,7 @@ void main() {
   v_world = a_position;
   v_normal = a_normal;
   v_uv = a_uv;
-  v_colour = a_colour;
+  v_color = a_color;
   v_eye_depth = (u_cam_from_world * vec4(a_position, 1.0)).z;
   v_shadow_clip = u_shadow_from_world * vec4(a_position, 1.0);
   gl_PointSize = u_point_size;
@@ -36,19 +36,19 @@ const char* const kSurfaceFragment = R"(
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
-in vec3 v_colour;
+in vec3 v_color;
 in float v_eye_depth;
-layout(location = 0) out vec4 o_colour;
+layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_aux;  // visibility, n.l, eye depth, coverage
 
 // Compile-time constants: one program per combination, so llvmpipe runs no dead branches
 // (a single program with uniform switches ran 6x slower).
-const int u_albedo_source = ALBEDO_SOURCE;  // 0 atlas, 1 projective, 2 constant grey, 3 vertex colour
+const int u_albedo_source = ALBEDO_SOURCE;  // 0 atlas, 1 projective, 2 constant grey, 3 vertex color
 uniform sampler2D u_atlas;
 uniform bool u_has_atlas;
 uniform vec3 u_eye;
 uniform vec4 u_light;         // (towards-light direction, 0) or (position, 1)
-uniform vec3 u_light_colour;  // Irradiance (directional) or intensity (point), linear RGB.
+uniform vec3 u_light_color;  // Irradiance (directional) or intensity (point), linear RGB.
 uniform float u_ambient;
 uniform float u_specular;
 uniform float u_shininess;
@@ -104,7 +104,7 @@ float ShadowVisibility() {
   return sum / float(4 * r * r);
 }
 
-// A photo projected like a slide: its colour and a weight, zero where the projector's depth
+// A photo projected like a slide: its color and a weight, zero where the projector's depth
 // map says the surface is hidden from that camera, or outside its image.
 vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, vec3 centre,
              vec3 view_dir) {
@@ -123,8 +123,8 @@ vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, 
   float cosine = max(dot(normalize(centre - v_world), view_dir), 0.0);
   float weight = pow(cosine, 64.0) + 1e-6;
   // Photos are stored top row first; t = 1 - v / H flips into texture coordinates.
-  vec3 colour = texture(photo, vec2(uv.x, 1.0 - uv.y)).rgb;
-  return vec4(colour * weight, weight);
+  vec3 color = texture(photo, vec2(uv.x, 1.0 - uv.y)).rgb;
+  return vec4(color * weight, weight);
 }
 
 void main() {
@@ -143,7 +143,7 @@ void main() {
   if (dot(n, view_dir) < 0.0) n = -n;
 
   vec3 to_light = u_light.xyz;
-  vec3 irradiance = u_light_colour;
+  vec3 irradiance = u_light_color;
   if (u_light.w > 0.5) {
     to_light = u_light.xyz - v_world;
     float d2 = max(dot(to_light, to_light), 1e-20);
@@ -167,7 +167,7 @@ void main() {
   if (u_albedo_source == 0) {
     albedo = texture(u_atlas, v_uv).rgb;  // An sRGB texture: sampling returns linear values.
   } else if (u_albedo_source == 3) {
-    albedo = SrgbToLinear(v_colour);
+    albedo = SrgbToLinear(v_color);
   } else if (u_albedo_source == 1) {
     vec4 sum = Project(u_photo0, u_projector_depth0, u_projector_from_world[0], u_projector_centre[0], view_dir);
     if (u_num_projectors > 1) sum += Project(u_photo1, u_projector_depth1, u_projector_from_world[1], u_projector_centre[1], view_dir);
@@ -181,14 +181,14 @@ void main() {
     }
   }
 
-  vec3 colour = albedo;
+  vec3 color = albedo;
   if (relight) {
     float lit = visibility * max(n_dot_l, 0.0);
     vec3 h = normalize(to_light + view_dir);
     float highlight = n_dot_l > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
-    colour = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * u_specular * highlight * irradiance;
+    color = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * u_specular * highlight * irradiance;
   }
-  o_colour = vec4(LinearToSrgb(colour * u_exposure), 1.0);
+  o_color = vec4(LinearToSrgb(color * u_exposure), 1.0);
   o_aux = vec4(visibility, n_dot_l, v_eye_depth, 1.0);
 }
 )";
@@ -210,7 +210,7 @@ void main() {}
 
 const char* const kPlanarVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
-layout(location = 3) in vec3 a_colour;  // Mesh: x = the triangle's greatest height.
+layout(location = 3) in vec3 a_color;  // Mesh: x = the triangle's greatest height.
 uniform mat4 u_clip_from_world;
 uniform mat4 u_planar_shadow;  // Flattens onto the ground along the light.
 uniform vec4 u_ground;
@@ -219,7 +219,7 @@ uniform bool u_points;
 out float v_height;
 void main() {
   // Whole triangles cast (the foot of a box too); a point casts by its own height.
-  v_height = u_points ? dot(u_ground.xyz, a_position) + u_ground.w : a_colour.x;
+  v_height = u_points ? dot(u_ground.xyz, a_position) + u_ground.w : a_color.x;
   gl_PointSize = u_point_size;
   gl_Position = u_clip_from_world * (u_planar_shadow * vec4(a_position, 1.0));
 }
@@ -237,22 +237,22 @@ void main() {
 
 const char* const kLineVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
-layout(location = 3) in vec3 a_colour;  // Linear RGB.
+layout(location = 3) in vec3 a_color;  // Linear RGB.
 uniform mat4 u_clip_from_world;
-out vec3 v_colour;
+out vec3 v_color;
 void main() {
-  v_colour = a_colour;
+  v_color = a_color;
   gl_Position = u_clip_from_world * vec4(a_position, 1.0);
 }
 )";
 
 const char* const kLineFragment = R"(#version 330 core
-in vec3 v_colour;
-layout(location = 0) out vec4 o_colour;
+in vec3 v_color;
+layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_aux;
 void main() {
-  vec3 c = clamp(v_colour, 0.0, 1.0);
-  o_colour = vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
+  vec3 c = clamp(v_color, 0.0, 1.0);
+  o_color = vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
   o_aux = vec4(1.0, 1.0, 0.0, 0.0);  // Not a surface.
 }
 )";

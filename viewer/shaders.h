@@ -17,7 +17,7 @@ extern const char* const kDepthFragment;
 extern const char* const kPlanarVertex;
 extern const char* const kPlanarFragment;
 
-// Coloured lines: camera frusta and the ground grid.
+// Colored lines: camera frusta and the ground grid.
 extern const char* const kLineVertex;
 extern const char* const kLineFragment;
 

@@ -78,7 +78,7 @@ Eigen::AlignedBox3f FocusBounds(const std::vector<Eigen::Vector3f>& samples,
 
 // Every k-th point, at most about `count` of them (deterministic): robust statistics and the
 // ground fit need no million points.
-std::vector<Eigen::Vector3f> Subsample(const std::vector<ColouredPoint>& points, size_t count) {
+std::vector<Eigen::Vector3f> Subsample(const std::vector<ColoredPoint>& points, size_t count) {
   const size_t stride = std::max<size_t>(1, (points.size() + count - 1) / count);
   std::vector<Eigen::Vector3f> positions;
   positions.reserve(points.size() / stride + 1);
@@ -99,13 +99,13 @@ std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path
 
 }  // namespace
 
-std::vector<ColouredPoint> ReadColouredPly(const fs::path& path) {
+std::vector<ColoredPoint> ReadColoredPly(const fs::path& path) {
   const TriangleMesh cloud = ReadPly(path);
-  std::vector<ColouredPoint> points(cloud.vertices.size());
+  std::vector<ColoredPoint> points(cloud.vertices.size());
   for (size_t i = 0; i < points.size(); ++i) {
     points[i].position = cloud.vertices[i];
     points[i].normal = cloud.normals.empty() ? Eigen::Vector3f::Zero() : cloud.normals[i];
-    points[i].colour = cloud.colours.empty() ? std::array<uint8_t, 3>{180, 180, 180} : cloud.colours[i];
+    points[i].color = cloud.colors.empty() ? std::array<uint8_t, 3>{180, 180, 180} : cloud.colors[i];
     if (!points[i].normal.allFinite()) {
       throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }
@@ -163,7 +163,7 @@ void FinishViewerScene(ViewerScene& scene) {
   }
   scene.bounds.setEmpty();
   for (const Eigen::Vector3f& v : scene.mesh.vertices) scene.bounds.extend(v);
-  for (const ColouredPoint& p : scene.points) scene.bounds.extend(p.position);
+  for (const ColoredPoint& p : scene.points) scene.bounds.extend(p.position);
   // What is shown: the mesh, sampled by area so a large ground of two triangles weighs as much
   // as it covers, else the cloud.
   constexpr size_t kSamples = 200000;
@@ -197,7 +197,7 @@ ViewerScene LoadViewerScene(const fs::path& workspace) {
   if (fs::exists(obj)) scene.mesh = ReadTexturedMesh(obj);
   const fs::path display = ws.DisplayMesh();
   if (!scene.mesh.triangles.empty() && fs::exists(display)) scene.display_mesh = ReadTexturedMesh(display);
-  if (fs::exists(ply)) scene.points = ReadColouredPly(ply);
+  if (fs::exists(ply)) scene.points = ReadColoredPly(ply);
   if (scene.mesh.triangles.empty() && scene.points.empty()) {
     throw BadInputError(workspace.string() +
                         ": nothing to show: no mesh/mesh.obj and no fused.ply in this folder "

@@ -27,10 +27,10 @@ struct ViewerSource {
   std::filesystem::path image_path;  // May not exist: the view is then never projected.
 };
 
-struct ColouredPoint {
+struct ColoredPoint {
   Eigen::Vector3f position;
   Eigen::Vector3f normal;          // Unit, or zero when the file has none.
-  std::array<uint8_t, 3> colour;   // sRGB.
+  std::array<uint8_t, 3> color;   // sRGB.
 };
 
 // Where the source cameras stand when they surround the scene looking in (a ring, a dome, an
@@ -47,7 +47,7 @@ struct ViewerScene {
   // A simplified copy for views whose pixels cannot show every triangle of `mesh`; no
   // triangles when the workspace has none (a small mesh is displayed as it is).
   TriangleMesh display_mesh;
-  std::vector<ColouredPoint> points; // Empty when the workspace has no fused.ply.
+  std::vector<ColoredPoint> points; // Empty when the workspace has no fused.ply.
   std::vector<ViewerSource> sources;
   Eigen::AlignedBox3f bounds;        // Exact bounds of the mesh and the points: for clipping.
   // Robust bounds (RobustBounds, 2% outliers a side) of what is shown: the mesh (area-weighted
@@ -82,8 +82,8 @@ ViewerScene LoadViewerScene(const std::filesystem::path& workspace);
 void FinishViewerScene(ViewerScene& scene);
 
 // The points of a PLY cloud (our fused.ply or COLMAP's), read by geometry/ply.h: normals zero
-// and colours grey where the file has none. Throws BadInputError naming the file.
-std::vector<ColouredPoint> ReadColouredPly(const std::filesystem::path& path);
+// and colors grey where the file has none. Throws BadInputError naming the file.
+std::vector<ColoredPoint> ReadColoredPly(const std::filesystem::path& path);
 
 // The rig of cameras looking in at a common point: nullopt with fewer than 3 cameras, when
 // their optical axes do not converge (e.g. a walk looking ahead), or when the point they

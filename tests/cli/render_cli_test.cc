@@ -61,9 +61,9 @@ TEST(RenderCli, SceneFolderNovelCamerasWriteImagesMasksDepthAndCsv) {
   ASSERT_EQ(csv.size(), 5u);  // Header + 4 novel views.
   EXPECT_EQ(csv[0].rfind("name,sources,hole_ratio,hole_ratio_filled,", 0), 0u) << csv[0];
   for (const std::string name : {"novel_0000", "novel_0001", "novel_0002", "novel_0003"}) {
-    const Image colour = ReadImage(dir.Path() / (name + std::string(".png")));
-    EXPECT_EQ(colour.Width(), 320);
-    EXPECT_EQ(colour.Height(), 240);
+    const Image color = ReadImage(dir.Path() / (name + std::string(".png")));
+    EXPECT_EQ(color.Width(), 320);
+    EXPECT_EQ(color.Height(), 240);
     const Image holes = ReadImage(dir.Path() / (name + std::string(".holes.png")));
     EXPECT_EQ(holes.Channels(), 1);
     const DepthMap depth = ReadDepthExr(dir.Path() / (name + std::string(".depth.exr")));

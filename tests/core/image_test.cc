@@ -85,7 +85,7 @@ TEST(Image, SrgbConversionInvertsAndMatchesTheStandard) {
   rgba.At(0, 0, 3) = 0.5f;
   const Image linear = SrgbToLinear(rgba);
   EXPECT_NEAR(linear.At(0, 0, 0), 0.21404f, 1e-5f);
-  EXPECT_FLOAT_EQ(linear.At(0, 0, 3), 0.5f);  // Alpha is not a colour.
+  EXPECT_FLOAT_EQ(linear.At(0, 0, 3), 0.5f);  // Alpha is not a color.
 }
 
 TEST(Image, ReadingCorruptOrMissingFilesNamesTheFile) {

@@ -313,7 +313,7 @@ TEST(DepthEvaluation, ErrorImagesHaveTheTruthSizeAndMarkMissingAndBackground) {
   EXPECT_LE(difference(pixel(5, 5), DepthErrorColor(0)), step);
 }
 
-TEST(DepthEvaluation, ErrorColoursRunFromDarkBlueToRedAndSaturate) {
+TEST(DepthEvaluation, ErrorColorsRunFromDarkBlueToRedAndSaturate) {
   const Eigen::Vector3f zero = DepthErrorColor(0);
   const Eigen::Vector3f red = DepthErrorColor(0.02);
   EXPECT_GT(zero.z(), zero.x());  // Blue.

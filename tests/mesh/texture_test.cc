@@ -17,7 +17,7 @@
 namespace parallax {
 namespace {
 
-// Linear colour painted on the plane z = 5, smooth enough to be resampled.
+// Linear color painted on the plane z = 5, smooth enough to be resampled.
 Eigen::Vector3f Paint(double x, double y) {
   return Eigen::Vector3f(static_cast<float>(0.5 + 0.4 * std::sin(3 * x)),
                          static_cast<float>(0.5 + 0.4 * std::cos(2 * y)),
@@ -30,12 +30,12 @@ constexpr double kPlaneDepth = 5;
 TextureView PlaneView() {
   TextureView view;
   view.camera = MakePinholeCamera(1, 96, 72, 80, 80, 48, 36);
-  view.colour = Image(96, 72, 3);
+  view.color = Image(96, 72, 3);
   for (int y = 0; y < 72; ++y) {
     for (int x = 0; x < 96; ++x) {
-      const Eigen::Vector3f colour =
+      const Eigen::Vector3f color =
           Paint((x + 0.5 - 48) / 80 * kPlaneDepth, (y + 0.5 - 36) / 80 * kPlaneDepth);
-      for (int c = 0; c < 3; ++c) view.colour.At(x, y, c) = colour[c];
+      for (int c = 0; c < 3; ++c) view.color.At(x, y, c) = color[c];
     }
   }
   return view;
@@ -82,7 +82,7 @@ TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
     for (int x = 0; x < 96; ++x) {
       ASSERT_TRUE(covered[static_cast<size_t>(y * 96 + x)]);
       for (int c = 0; c < 3; ++c) {
-        const double d = render.At(x, y, c) - LinearToSrgb(view.colour.At(x, y, c));
+        const double d = render.At(x, y, c) - LinearToSrgb(view.color.At(x, y, c));
         squared += d * d;
       }
       ++pixels;

@@ -1,5 +1,5 @@
 #pragma once
-// Scenes of planes and axis-aligned boxes, ray cast at pixel centres into colour and z-depth,
+// Scenes of planes and axis-aligned boxes, ray cast at pixel centres into color and z-depth,
 // so reproject tests have exact ground truth without files.
 #include <algorithm>
 #include <cmath>
@@ -126,7 +126,7 @@ inline PosedCamera CameraAt(const Camera& camera, const Eigen::Vector3d& center,
   return {camera, Rigid3d(cam_from_world_rotation, -(cam_from_world_rotation * center))};
 }
 
-// A smooth texture of the given world period around a base colour (linear RGB).
+// A smooth texture of the given world period around a base color (linear RGB).
 inline ColorFn WavyTexture(const Eigen::Vector3f& base, double period) {
   return [base, period](const Eigen::Vector3d& p) {
     const double w = 2 * kPi / period;

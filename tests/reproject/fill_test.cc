@@ -36,7 +36,7 @@ RenderResult RenderWith(const FillCase& c, FillMethod fill) {
   return Render({&c.source}, c.target, options);
 }
 
-TEST(FillHoles, DepthAwareFillTakesTheBackgroundColour) {
+TEST(FillHoles, DepthAwareFillTakesTheBackgroundColor) {
   const FillCase c = RedBoxBlueWall();
   const RenderResult result = RenderWith(c, FillMethod::kDepthAware);
   ASSERT_GT(result.metrics.disocclusion_ratio, 0.01);
@@ -46,7 +46,7 @@ TEST(FillHoles, DepthAwareFillTakesTheBackgroundColour) {
       if (!IsHole(result.classes.At(x, y))) continue;
       ++checked;
       for (int ch = 0; ch < 3; ++ch) {
-        // The wall's colour within the roundings of the texture and the warp buffer (half
+        // The wall's color within the roundings of the texture and the warp buffer (half
         // floats).
         ASSERT_NEAR(result.color.At(x, y, ch), kWallBlue(ch),
                     1e-4 + 2 * WarpBuffer::kHalfRounding * static_cast<double>(kWallBlue(ch)))
@@ -115,8 +115,8 @@ TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
                    std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion), {}};
   for (int x : {0, kWidth - 1}) {
     const size_t i = static_cast<size_t>(kRow * kWidth + x);
-    const Eigen::Vector3f& colour = x == 0 ? kBoxRed : kWallBlue;
-    for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = colour(ch);
+    const Eigen::Vector3f& color = x == 0 ? kBoxRed : kWallBlue;
+    for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
     blend.depth.Values()[i] = 3;
     blend.kind[i] = SampleKind::kSurface;
     classes.classes[i] = PixelClass::kCovered;
@@ -154,8 +154,8 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
           continue;
         }
         const bool ground = y >= kGround;
-        const Eigen::Vector3f& colour = ground ? kWallBlue : sky;
-        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = colour(ch);
+        const Eigen::Vector3f& color = ground ? kWallBlue : sky;
+        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
         blend.depth.Values()[i] = ground ? 5.0f : 0.0f;
         blend.kind[i] = ground ? SampleKind::kSurface : SampleKind::kBackground;
         classes.classes[i] = ground ? PixelClass::kCovered : PixelClass::kBackground;
@@ -183,7 +183,7 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
-// A sky whose colour is affine in the direction (y is down: bluer upwards), seen by a source
+// A sky whose color is affine in the direction (y is down: bluer upwards), seen by a source
 // looking level and rendered by a target pitched 12 degrees up: the target's top rows are
 // sky no source saw.
 TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
@@ -199,7 +199,7 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
       CameraAt(camera, {0, 0, 0}, Eigen::Quaterniond(Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX())));
   const RenderResult result = Render({&source}, target);
   ASSERT_GT(result.metrics.out_of_view_ratio, 0.15);
-  double worst = 0, worst_edge_colour = 0;
+  double worst = 0, worst_edge_color = 0;
   int checked = 0;
   // The top row of sky the source saw: what copying the edge of the sampled sky would give.
   const Eigen::Vector3f edge = scene.sky(test::PixelRay(source.Posed(), 80, 0).normalized());
@@ -210,16 +210,16 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
       const Eigen::Vector3f truth = scene.sky(test::PixelRay(target, x, y).normalized());
       for (int ch = 0; ch < 3; ++ch) {
         worst = std::max(worst, static_cast<double>(std::abs(result.color.At(x, y, ch) - truth(ch))));
-        worst_edge_colour = std::max(worst_edge_colour, static_cast<double>(std::abs(edge(ch) - truth(ch))));
+        worst_edge_color = std::max(worst_edge_color, static_cast<double>(std::abs(edge(ch) - truth(ch))));
       }
       ASSERT_EQ(result.depth.At(x, y), 0);
     }
   }
   EXPECT_GT(checked, 2000);
-  // The sky's colour is affine in the direction, so the model fits it up to float rounding
+  // The sky's color is affine in the direction, so the model fits it up to float rounding
   // and the bilinear resampling of the warped sky.
   EXPECT_LT(worst, 0.003);
-  EXPECT_GT(worst_edge_colour, 0.02);  // What copying the edge would miss it by.
+  EXPECT_GT(worst_edge_color, 0.02);  // What copying the edge would miss it by.
 }
 
 }  // namespace

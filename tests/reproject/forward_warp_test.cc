@@ -234,8 +234,8 @@ TEST(MarkBackground, OnlyDepthZeroConnectedToTheBorderIsBackground) {
   EXPECT_EQ(background[2 * 8 + 2], 0);
 }
 
-// No depth along the bottom border: smooth sky-like colour there is background, a texture
-// (ground the depth stage missed) is not, and the colour test can be turned off.
+// No depth along the bottom border: smooth sky-like color there is background, a texture
+// (ground the depth stage missed) is not, and the color test can be turned off.
 TEST(MarkBackground, TexturedPixelsWithoutDepthAreUnknown) {
   DepthMap depth(8, 6);
   Image color(8, 6, 3);
@@ -309,7 +309,7 @@ TEST(ErodeDepthEdges, ClearsTheNearSideOfEdgesOnly) {
   EXPECT_THROW(ErodeDepthEdges(&slope, 0, 2), std::invalid_argument);
 }
 
-// Sky colour encodes the world direction, so a warped sky pixel tells where it came from.
+// Sky color encodes the world direction, so a warped sky pixel tells where it came from.
 Eigen::Vector3f SkyColor(const Eigen::Vector3d& dir) {
   return Eigen::Vector3f(static_cast<float>(0.5 + 0.4 * dir.x() / dir.z()),
                          static_cast<float>(0.5 + 0.4 * dir.y() / dir.z()), 0.3f);
@@ -354,8 +354,8 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
         ++wrong_class;
         continue;
       }
-      // Decode the direction the colour came from and compare in source pixels.
-      // Over 0.02 pixels plus the error of the colour's half roundings in pixels (texture and
+      // Decode the direction the color came from and compare in source pixels.
+      // Over 0.02 pixels plus the error of the color's half roundings in pixels (texture and
       // warp buffer).
       const double red = result.color.At(x, y, 0), green = result.color.At(x, y, 1);
       const double du = 150 * (red - 0.5) / 0.4 - 150 * dir.x() / dir.z();
@@ -373,7 +373,7 @@ TEST(ForwardWarp, SkyWarpsAsDirectionsUnderPureRotation) {
 }
 
 // A source's own background mask and texture (PrepareSource) warp exactly as those the warp
-// makes itself; a mask made with another colour step is not used.
+// makes itself; a mask made with another color step is not used.
 TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
   const Camera camera = TestCamera(160, 120, 150);
   const Scene scene = BoxInSky();
@@ -383,7 +383,7 @@ TEST(ForwardWarp, SourceBackgroundMaskIsUsedOnlyForItsStep) {
     WarpBuffer buffer;
     WarpScratch scratch;
     ForwardWarp(view, target, {}, &buffer, &scratch);
-    std::vector<float> samples;  // Depth, colour and weight of every pixel with a sample.
+    std::vector<float> samples;  // Depth, color and weight of every pixel with a sample.
     for (size_t i = 0; i < buffer.Size(); ++i) {
       if (buffer.Depth(i) == 0) continue;
       const std::array<float, 3> rgb = buffer.Color(i);
@@ -435,7 +435,7 @@ TEST(ForwardWarp, BandsDrawWhatOneBandDraws) {
           ++differ;
           continue;
         }
-        if (one.Depth(i) == 0) continue;  // Colour and weight mean nothing there.
+        if (one.Depth(i) == 0) continue;  // Color and weight mean nothing there.
         differ += std::memcmp(banded.ColorWeights() + 4 * i, one.ColorWeights() + 4 * i,
                               4 * sizeof(uint16_t)) != 0;
       }
@@ -502,7 +502,7 @@ TEST(ForwardWarp, BicubicTextureFilterKeepsFineTextureSharper) {
 // A slanted plane whose source depth grows 2.8-fold down the image (2.7 to 7.7), so an 8x8
 // block spans ~7% of depth: its texture must land where the geometry says (3e-5 px off; the
 // two triangles per 4x4 block before the projective map missed by 0.056 px, interpolating the
-// source position affinely). The source's colour is its own pixel coordinate (a ramp, which
+// source position affinely). The source's color is its own pixel coordinate (a ramp, which
 // bilinear and Catmull-Rom sampling both reproduce).
 TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
   const Camera camera = TestCamera();
@@ -534,7 +534,7 @@ TEST(ForwardWarp, MeshTextureFollowsTheSourceProjectionAcrossASlantedPlane) {
       const double sx = f * point.x() / point.z() + cx - 0.5;
       const double sy = f * point.y() / point.z() + cy - 0.5;
       if (sx < 1.5 || sy < 1.5 || sx > 157.5 || sy > 117.5) continue;
-      // Over 0.01 pixels plus the colour's half roundings in pixels (texture and warp buffer).
+      // Over 0.01 pixels plus the color's half roundings in pixels (texture and warp buffer).
       const double red = buffer.Color(i)[0], green = buffer.Color(i)[1];
       const auto bound = [](double value) { return 0.01 + 256 * 2 * WarpBuffer::kHalfRounding * value; };
       position_error_scaled = std::max({position_error_scaled, std::abs(red * 256 - sx) / bound(red),

@@ -199,7 +199,7 @@ Eigen::Quaterniond RandomRotation(std::mt19937& random, double max_angle_rad) {
 }
 
 // Sparse source samples (every 4th pixel, each alone) with log-uniform random depths in
-// [0.2, 200], coloured with their own pixel coordinates so the target tells which landed.
+// [0.2, 200], colored with their own pixel coordinates so the target tells which landed.
 SourceView SparseLabelledSource(std::mt19937& random) {
   const Camera camera = MakePinholeCamera(1, 160, 120, 150, 140, 81.3, 58.7);
   SourceView source{"sparse", camera, Rigid3d(), Image(160, 120, 3), DepthMap(160, 120), {}, 0, {}};

@@ -318,8 +318,8 @@ TEST(WarpStability, DepthDiscontinuityOfAMillionIsAHoleNeverBridged) {
   }
 }
 
-TEST(WarpStability, ColoursBeyondHalfFloatsSaturateAndTinyOnesStayFinite) {
-  // The warp keeps colour in half floats (largest finite 65504, smallest subnormal 6e-8).
+TEST(WarpStability, ColorsBeyondHalfFloatsSaturateAndTinyOnesStayFinite) {
+  // The warp keeps color in half floats (largest finite 65504, smallest subnormal 6e-8).
   // A wall whose left half is brighter than a half can hold (1e6, a sun in an EXR), HDR
   // (1000) and nearly black (1e-9), the right half ordinary: every output stays finite, the
   // overbright channel saturates at 65504 instead of turning into infinity, and the rest

@@ -52,9 +52,9 @@ TEST(ViewerProjective, ScreenshotFromASourceCameraReproducesItsPhoto) {
     const Image photo = ReadImage(kSmall / "images" / (std::filesystem::path(name).stem().string() + ".png"));
     if (const char* dir = std::getenv("PARALLAX_VIEWER_TEST_OUT")) {
       fs::create_directories(dir);
-      WriteImage(fs::path(dir) / ("projective_" + name + ".png"), result.colour, PixelFormat::kUint8);
+      WriteImage(fs::path(dir) / ("projective_" + name + ".png"), result.color, PixelFormat::kUint8);
     }
-    ASSERT_EQ(photo.Width(), result.colour.Width());
+    ASSERT_EQ(photo.Width(), result.color.Width());
     double squared = 0;
     int covered = 0;
     for (int y = 0; y < photo.Height(); ++y) {
@@ -62,7 +62,7 @@ TEST(ViewerProjective, ScreenshotFromASourceCameraReproducesItsPhoto) {
         if (!RenderedCovered(result.aux, x, y)) continue;
         ++covered;
         for (int c = 0; c < 3; ++c) {
-          const double d = static_cast<double>(result.colour.At(x, y, c) - photo.At(x, y, c));
+          const double d = static_cast<double>(result.color.At(x, y, c) - photo.At(x, y, c));
           squared += d * d;
         }
       }
@@ -79,11 +79,11 @@ TEST(ViewerProjective, ScreenshotFromASourceCameraReproducesItsPhoto) {
 double MeanRedShare(const FrameResult& frame) {
   double sum = 0;
   int covered = 0;
-  for (int y = 0; y < frame.colour.Height(); ++y) {
-    for (int x = 0; x < frame.colour.Width(); ++x) {
+  for (int y = 0; y < frame.color.Height(); ++y) {
+    for (int x = 0; x < frame.color.Width(); ++x) {
       if (!RenderedCovered(frame.aux, x, y)) continue;
-      const double total = frame.colour.At(x, y, 0) + frame.colour.At(x, y, 1) + frame.colour.At(x, y, 2);
-      sum += total > 0 ? static_cast<double>(frame.colour.At(x, y, 0)) / total : 0;
+      const double total = frame.color.At(x, y, 0) + frame.color.At(x, y, 1) + frame.color.At(x, y, 2);
+      sum += total > 0 ? static_cast<double>(frame.color.At(x, y, 0)) / total : 0;
       ++covered;
     }
   }
@@ -93,7 +93,7 @@ double MeanRedShare(const FrameResult& frame) {
 TEST(ViewerLevelOfDetail, DisplayMeshIsDrawnWhenThePixelsCannotShowEveryTriangle) {
   EnsureGlContext();
   ViewerScene scene = SmallScene();
-  // The same geometry with a red atlas stands in for the simplified copy: the colour tells
+  // The same geometry with a red atlas stands in for the simplified copy: the color tells
   // which level was drawn.
   scene.display_mesh = scene.mesh;
   scene.display_mesh.atlas = Image(2, 2, 3);
@@ -158,7 +158,7 @@ TEST(ViewerScene, FarOutliersOfTheCloudDoNotShrinkTheScene) {
   std::mt19937 random(5);
   std::uniform_real_distribution<float> ground(-10, 10), block(-2, 2), height(0, 3), far(-800, 800);
   for (int i = 0; i < 40000; ++i) {
-    ColouredPoint p{{ground(random), ground(random), 0}, {0, 0, 1}, {128, 128, 128}};
+    ColoredPoint p{{ground(random), ground(random), 0}, {0, 0, 1}, {128, 128, 128}};
     if (i % 4 == 0) p.position = {block(random), block(random), height(random)};
     if (i % 200 == 0) p.position = {far(random), far(random), std::abs(far(random))};
     scene.points.push_back(p);
@@ -215,13 +215,13 @@ TEST(ViewerProjective, LookingThroughASourceCameraHidesItsFrustum) {
   settings.show_cameras = false;
   const FrameResult without = renderer.Render(view, settings);
   int different = 0;
-  for (int y = 0; y < with.colour.Height(); ++y) {
-    for (int x = 0; x < with.colour.Width(); ++x) {
-      different += (with.colour.At(x, y, 0) != without.colour.At(x, y, 0));
+  for (int y = 0; y < with.color.Height(); ++y) {
+    for (int x = 0; x < with.color.Width(); ++x) {
+      different += (with.color.At(x, y, 0) != without.color.At(x, y, 0));
     }
   }
   std::printf("[ measure ] frusta seen from camera 0006: %d pixels\n", different);
-  EXPECT_LT(different, with.colour.Width() * with.colour.Height() / 100);
+  EXPECT_LT(different, with.color.Width() * with.color.Height() / 100);
 }
 
 TEST(ViewerScene, GroundPlaneIsFoundDespiteOutliers) {

@@ -19,7 +19,7 @@ void MaybeSave(const std::string& name, const FrameResult& result) {
   const char* dir = std::getenv("PARALLAX_VIEWER_TEST_OUT");
   if (!dir) return;
   std::filesystem::create_directories(dir);
-  WriteImage(std::filesystem::path(dir) / (name + ".png"), result.colour, PixelFormat::kUint8);
+  WriteImage(std::filesystem::path(dir) / (name + ".png"), result.color, PixelFormat::kUint8);
 }
 
 const Eigen::Vector3d kLight = Eigen::Vector3d(-0.5, -0.3, -0.8).normalized();
@@ -193,7 +193,7 @@ TEST(ViewerShadows, GrazingLightGivesNoNanAndNoFullScreenAcne) {
   const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, light);
   for (ShadowMode mode : {ShadowMode::kMap, ShadowMode::kPcf, ShadowMode::kPlanar}) {
     const FrameResult result = renderer.Render(view, ShadowSettings(mode, light));
-    for (float v : result.colour.Pixels()) ASSERT_TRUE(std::isfinite(v));
+    for (float v : result.color.Pixels()) ASSERT_TRUE(std::isfinite(v));
     for (float v : result.aux.Pixels()) ASSERT_TRUE(std::isfinite(v));
     // Pixels shadowed by the renderer that the ray tracer sees lit.
     int lit = 0, false_shadow = 0;
