@@ -85,7 +85,7 @@ SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& 
 
 // A final bundle adjustment that also frees the principal point, kept only when the point
 // stays near the image centre: where it is unobservable (a narrow arc of small images) it
-// drifts far off and the rotations with it (6.6 degrees on example_images/small).
+// drifts far off and the rotations with it.
 std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
                                  const ReconstructOptions& options, Progress& progress) {
   const fs::path refined = paths.RefinedModelScratch();

@@ -73,7 +73,7 @@ template <typename T>
 void Allocate(PixelArray<T>* array, size_t count) {
   // Per-pixel arrays of a megabyte and more start on a huge page and are advised to use them
   // (Linux): a warp writes and reads them scattered across the image, missing the TLB with
-  // 4 KB pages. K=4 render at 1920x1080 ~213 -> ~200 ms (A/B, three rounds); 640x480 the same.
+  // 4 KB pages.
   constexpr size_t kHugePage = size_t{2} << 20;
   const size_t bytes = count * sizeof(T);
   if (bytes < (size_t{1} << 20)) {
@@ -89,17 +89,13 @@ void Allocate(PixelArray<T>* array, size_t count) {
 }
 
 // The side of the largest blocks of the mesh (SourceWarper::Mesh), the grid they start on.
-// 8: courtyard novel views from ground-truth sources 33.52 dB with 4, 8 and 16 alike (when a
-// block was two triangles interpolating the source position affinely, 8 lost 0.13 dB to 4
-// on grazing ground); one 640x480 warp ~6.5 -> ~6.2 ms, K=4 at 1920x1080 ~204 -> ~190 ms.
+// 8: as accurate as 4 and 16 on the courtyard's novel views.
 constexpr int kMaxBlock = 8;
 
 // A band's vertices (with, for a mesh, the quads and silhouette penalties), prepared in source
 // row order as its walk reaches them, and only the few rows the walk reads at a time kept:
 // they stay in cache, where a whole source's vertices (~5 MB at 640x480), prepared first,
-// came back from memory out of a cache that the other thread's warp shares. K=4 render,
-// 640x480: 19.9 ms with the whole source prepared first, 18.4 prepared in order, 16.5 with
-// this window (1920x1080: 167 -> 137 ms; A/B medians).
+// came back from memory out of a cache that the other thread's warp shares.
 class RowWindow {
  public:
   // A block row of the mesh reads the vertex rows from the one above it to the one below it
@@ -383,9 +379,8 @@ class SourceWarper {
 
   // Whether sample j lies beyond surface sample i, seen from the source: sky, unknown depth,
   // or a surface farther than one surface's depth ratio. Unknown depth counts so that an
-  // occluder beside estimated depth's eroded edges still shrinks (estimated courtyard views
-  // 28.42 dB; 28.34 with unknown depth counting as neither), though nothing on the far side
-  // of that gap grows to meet it.
+  // occluder beside estimated depth's eroded edges still shrinks, though nothing on the far
+  // side of that gap grows to meet it.
   bool Beyond(size_t i, size_t j) const {
     return Kind(j) != kSurface || SourceDepth(j) > s_.max_depth_ratio * SourceDepth(i);
   }

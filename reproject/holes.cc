@@ -77,8 +77,7 @@ enum class PointView { kOutside, kFree, kHidden, kUnknown };
 // target ray whose source-frame direction is `dir`: outside its image, empty space (its depth
 // there is larger, or background), hidden (its depth is not larger), or unknown (depth 0 that
 // is not background: the source saw something there, at a depth nobody knows). Inline: with
-// two callers GCC stopped inlining it into RayIsHole's loop (classification 2.78 -> 3.0 ms in
-// the K=4 render core).
+// two callers GCC stopped inlining it into RayIsHole's loop.
 inline PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir,
                              double inv_depth, double tolerance) {
   // The point scaled by inv_depth: the same pixel, and z / depth = p.z().
@@ -95,7 +94,7 @@ inline PointView ViewOfPoint(const SourceFrustum& s, const Eigen::Vector3d& dir,
   const double depth = s.depth->Values()[i];
   if (depth == 0) {
     // Background is among the depth-0 pixels (MarkBackground): its mask is read only there,
-    // not for every sample (K=4 render 1920x1080: classification 10.5 -> 10.3 ms).
+    // not for every sample.
     return s.background != nullptr && s.background[i] != 0 ? PointView::kFree : PointView::kUnknown;
   }
   // depth > z * (1 + tolerance) with z = p.z() / inv_depth; at infinity nothing finite is
@@ -152,8 +151,7 @@ bool RayIsHole(const std::vector<SourceFrustum>& sources, const std::vector<Eige
   }
   // Beyond it any hidden point up to the near end does. A hole's ray has passed under what
   // the sources saw by its far end, so the points are looked at from there back: the same
-  // answer after a few points instead of ~46 of 48 (K=4 render: classification 10.2 -> 5.5
-  // ms at 1920x1080, 1.27 -> 0.75 ms at 640x480).
+  // answer after a few points instead of most of them.
   for (int k = samples - 1; k > first_free; --k) {
     const double inv_depth = inv_depth_at(k);
     const Seen seen = look(inv_depth);

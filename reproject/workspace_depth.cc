@@ -29,8 +29,8 @@ int FillFromMesh(const MeshRaycaster& caster, const SourceView& view, DepthMap* 
   std::vector<float>& values = depth->Values();
   if (hits.size() != values.size()) return 0;
   // Every depth-0 pixel the mesh covers, sky-colored ones too: keeping those that
-  // MarkBackground calls sky out of the fill cost 0.2 dB on the courtyard (27.15 -> 26.93):
-  // the mesh is right there more often than a smooth color is sky.
+  // MarkBackground calls sky out of the fill lost accuracy: the mesh is right there more
+  // often than a smooth color is sky.
   int filled = 0;
   for (size_t i = 0; i < hits.size(); ++i) {
     const float z = hits[i].depth;

@@ -204,8 +204,8 @@ GlTexture UploadSrgbTexture(const Image& image) {
                GL_UNSIGNED_BYTE, bytes.data());
   glGenerateMipmap(GL_TEXTURE_2D);
   SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
-  // Bilinear in the nearest mip level: half the texel fetches of trilinear, ~2 ms a 720p frame
-  // on llvmpipe, and within 50 dB of it on the courtyard.
+  // Bilinear in the nearest mip level: half the texel fetches of trilinear, and nearly the
+  // same image.
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
   return texture;
 }

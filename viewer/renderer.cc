@@ -418,7 +418,7 @@ void SceneRenderer::Impl::BeginFrame(int width, int height, const FrameSettings&
   const float clear_aux[4] = {1, 0, 0, 0};
   glClearBufferfv(GL_COLOR, 0, clear_color);
   // The auxiliary target is read back by Render alone: a frame for the window (or a timing)
-  // leaves it out, which saves llvmpipe 16 bytes a pixel written, about 13% of a frame.
+  // leaves it out, which saves llvmpipe 16 bytes a pixel written.
   const GLenum draw_buffers[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
   glDrawBuffers(2, draw_buffers);
   if (with_aux) glClearBufferfv(GL_COLOR, 1, clear_aux);
