@@ -1,12 +1,12 @@
 #include "geometry/obj.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <tiny_obj_loader.h>
@@ -47,35 +47,39 @@ std::string ObjText(const TriangleMesh& mesh) {
   throw BadInputError(path.string() + ":" + std::to_string(line_number) + ": " + what);
 }
 
-// The 1-based line numbers of the lines starting with `keyword` (a word of its own), in order:
-// tinyobjloader keeps no line numbers, the errors about its vertices and faces name them.
-std::vector<size_t> KeywordLines(const std::string& text, const std::string& keyword) {
-  std::vector<size_t> lines;
+// Where the OBJ's vertices, faces and first mtllib are (1-based line numbers), found in one
+// pass: tinyobjloader keeps no line numbers, and the errors about vertices and faces name them.
+struct ObjLines {
+  std::vector<size_t> vertices;  // `v` lines, in order.
+  std::vector<size_t> faces;     // `f` lines, in order.
+  size_t mtllib = 0;             // 0: none.
+  std::string mtllib_file;       // The file it names; empty when it names none.
+};
+
+ObjLines IndexLines(const std::string& text) {
+  const auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  ObjLines lines;
   size_t number = 1;
   for (size_t start = 0; start < text.size(); ++number) {
     const size_t end = std::min(text.find('\n', start), text.size());
-    const size_t first = text.find_first_not_of(" \t", start);
-    if (first < end && text.compare(first, keyword.size(), keyword) == 0 &&
-        first + keyword.size() < end && std::isspace(static_cast<unsigned char>(text[first + keyword.size()]))) {
-      lines.push_back(number);
+    size_t first = start;
+    while (first < end && is_blank(text[first])) ++first;
+    size_t last = first;
+    while (last < end && !is_blank(text[last])) ++last;
+    const std::string_view keyword(text.data() + first, last - first);
+    const bool has_data = last < end;  // As tinyobjloader: a keyword alone on its line is no element.
+    if (keyword == "v" && has_data) {
+      lines.vertices.push_back(number);
+    } else if (keyword == "f" && has_data) {
+      lines.faces.push_back(number);
+    } else if (keyword == "mtllib" && lines.mtllib == 0) {
+      lines.mtllib = number;
+      std::istringstream words(text.substr(last, end - last));
+      words >> lines.mtllib_file;
     }
     start = end + 1;
   }
   return lines;
-}
-
-// The file the first `mtllib` line names, beside the OBJ. Throws BadInputError without one.
-fs::path MaterialPath(const std::string& text, const fs::path& obj_path) {
-  const std::vector<size_t> lines = KeywordLines(text, "mtllib");
-  if (lines.empty()) throw BadInputError(obj_path.string() + ": no mtllib");
-  std::istringstream all(text);
-  std::string line;
-  for (size_t number = 1; number <= lines.front(); ++number) std::getline(all, line);
-  std::istringstream words(line);
-  std::string keyword, file;
-  words >> keyword >> file;
-  if (file.empty()) Malformed(obj_path, lines.front(), "mtllib names no file");
-  return obj_path.parent_path() / file;
 }
 
 // The triangles and corner texture coordinates of `reader`'s shapes, checked against the
@@ -136,7 +140,10 @@ fs::path AtlasPath(const fs::path& mtl_path, const fs::path& obj_path) {
 
 TriangleMesh ReadTexturedMesh(const fs::path& obj_path) {
   const std::string text = ReadFileBytes(obj_path);
-  const fs::path mtl_path = MaterialPath(text, obj_path);
+  const ObjLines lines = IndexLines(text);
+  if (lines.mtllib == 0) throw BadInputError(obj_path.string() + ": no mtllib");
+  if (lines.mtllib_file.empty()) Malformed(obj_path, lines.mtllib, "mtllib names no file");
+  const fs::path mtl_path = obj_path.parent_path() / lines.mtllib_file;
   tinyobj::ObjReaderConfig config;
   config.triangulate = false;  // A polygon is an error, not split.
   config.vertex_color = false;
@@ -146,13 +153,12 @@ TriangleMesh ReadTexturedMesh(const fs::path& obj_path) {
   }
   TriangleMesh mesh;
   const std::vector<float>& vertices = reader.GetAttrib().vertices;
-  const std::vector<size_t> vertex_lines = KeywordLines(text, "v");
   for (size_t i = 0; i + 2 < vertices.size(); i += 3) {
     const Eigen::Vector3f v(vertices[i], vertices[i + 1], vertices[i + 2]);
-    if (!v.allFinite()) Malformed(obj_path, i / 3 < vertex_lines.size() ? vertex_lines[i / 3] : 0, "bad vertex");
+    if (!v.allFinite()) Malformed(obj_path, i / 3 < lines.vertices.size() ? lines.vertices[i / 3] : 0, "bad vertex");
     mesh.vertices.push_back(v);
   }
-  CopyTriangles(reader, KeywordLines(text, "f"), obj_path, mesh);
+  CopyTriangles(reader, lines.faces, obj_path, mesh);
   mesh.atlas = ReadImage(AtlasPath(mtl_path, obj_path));
   if (mesh.atlas.Channels() < 3) {
     throw BadInputError(obj_path.string() + ": the atlas must be an RGB image");

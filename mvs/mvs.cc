@@ -149,6 +149,7 @@ namespace {
 // The views whose depth is written (`written`) and those PatchMatch runs on (`estimated`): the
 // written ones plus the sources the geometric filter checks them against.
 struct DepthPlan {
+  std::set<std::string> wanted;  // MvsOptions::only_views; empty: every view.
   std::vector<ViewPlan> all;
   std::vector<ViewPlan> written;
   std::vector<ViewPlan> estimated;
@@ -157,7 +158,8 @@ struct DepthPlan {
 DepthPlan PlanDepth(const SparseModel& model, const MvsOptions& options, const fs::path& workspace) {
   DepthPlan plan;
   plan.all = PlanViews(model, options.views);
-  const std::set<std::string> wanted(options.only_views.begin(), options.only_views.end());
+  plan.wanted = {options.only_views.begin(), options.only_views.end()};
+  const std::set<std::string>& wanted = plan.wanted;
   std::set<uint32_t> estimated;
   for (const ViewPlan& view : plan.all) {
     if (!wanted.empty() && !wanted.count(view.name)) continue;
@@ -179,9 +181,8 @@ DepthPlan PlanDepth(const SparseModel& model, const MvsOptions& options, const f
 }
 
 // Why each image of the model gets no depth map.
-std::vector<std::string> SkippedViews(const SparseModel& model, const DepthPlan& plan,
-                                      const MvsOptions& options) {
-  const std::set<std::string> wanted(options.only_views.begin(), options.only_views.end());
+std::vector<std::string> SkippedViews(const SparseModel& model, const DepthPlan& plan) {
+  const std::set<std::string>& wanted = plan.wanted;
   std::vector<std::string> skipped;
   for (const SparseImage& image : model.Images()) {
     const bool planned = std::any_of(plan.all.begin(), plan.all.end(),
@@ -267,7 +268,7 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
   const DepthPlan plan = PlanDepth(model, options, workspace);
   MvsSummary summary;
   summary.estimated_views = static_cast<int>(plan.estimated.size());
-  summary.skipped = SkippedViews(model, plan, options);
+  summary.skipped = SkippedViews(model, plan);
   const std::map<uint32_t, StereoView> views = LoadStereoViews(ws, model, plan.estimated, options.image_scale);
 
   auto start = std::chrono::steady_clock::now();
@@ -301,38 +302,6 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
   progress.Update("filter", total, total);
   summary.geometric_seconds = Seconds(start);
   return summary;
-}
-
-void to_json(nlohmann::json& json, const MvsViewReport& view) {
-  json = {{"name", view.name},
-          {"sources", view.sources},
-          {"min_depth", view.min_depth},
-          {"max_depth", view.max_depth},
-          {"photometric_share", view.photometric_share},
-          {"geometric_share", view.geometric_share}};
-}
-
-void from_json(const nlohmann::json& json, MvsViewReport& view) {
-  json.at("name").get_to(view.name);
-  json.at("sources").get_to(view.sources);
-  json.at("min_depth").get_to(view.min_depth);
-  json.at("max_depth").get_to(view.max_depth);
-  json.at("photometric_share").get_to(view.photometric_share);
-  json.at("geometric_share").get_to(view.geometric_share);
-}
-
-void to_json(nlohmann::json& json, const MvsSummary& summary) {
-  json = {{"views", summary.views},
-          {"skipped", summary.skipped},
-          {"photometric_seconds", summary.photometric_seconds},
-          {"geometric_seconds", summary.geometric_seconds}};
-}
-
-void from_json(const nlohmann::json& json, MvsSummary& summary) {
-  json.at("views").get_to(summary.views);
-  json.at("skipped").get_to(summary.skipped);
-  json.at("photometric_seconds").get_to(summary.photometric_seconds);
-  json.at("geometric_seconds").get_to(summary.geometric_seconds);
 }
 
 }  // namespace parallax

@@ -55,11 +55,11 @@ struct MvsSummary {
   double geometric_seconds = 0;
 };
 
-// <ws>/depth/views.json and report.json's "depth" section.
-void to_json(nlohmann::json& json, const MvsViewReport& view);
-void from_json(const nlohmann::json& json, MvsViewReport& view);
-void to_json(nlohmann::json& json, const MvsSummary& summary);
-void from_json(const nlohmann::json& json, MvsSummary& summary);
+// <ws>/depth/views.json and report.json's "depth" section: every field under its own name.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MvsViewReport, name, sources, min_depth, max_depth,
+                                   photometric_share, geometric_share)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MvsSummary, views, skipped, photometric_seconds,
+                                   geometric_seconds)
 
 // Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
 MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,

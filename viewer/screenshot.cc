@@ -56,8 +56,7 @@ ViewCamera ScreenshotCamera(const ViewerScene& scene, const ScreenshotOptions& o
     return OrbitViewCamera(scene, options.orbit_deg.value_or(30), options.elevation_deg, width, height,
                            options.fov_deg);
   }
-  const ViewCamera view = SourceViewCamera(scene, options.camera);  // Throws for an unknown name.
-  if (!options.size) return view;
+  if (!options.size) return SourceViewCamera(scene, options.camera);  // Throws for an unknown name.
   const ViewerSource& source = scene.sources[static_cast<size_t>(*SourceIndex(scene, options.camera))];
   return ScaledSourceViewCamera(source, options.size->first, options.size->second);
 }

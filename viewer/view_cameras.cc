@@ -9,24 +9,14 @@
 
 namespace parallax {
 
-std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name) {
-  if (name.empty()) return std::nullopt;
-  SourceViewCamera(scene, name);  // Throws with the known names when there is none.
+namespace {
+
+// The index of the source whose image name or stem is `name`. Throws BadInputError listing a
+// few names when none matches.
+int FindSource(const ViewerScene& scene, const std::string& name) {
   for (size_t i = 0; i < scene.sources.size(); ++i) {
     if (scene.sources[i].name == name || std::filesystem::path(scene.sources[i].name).stem() == name) {
       return static_cast<int>(i);
-    }
-  }
-  return std::nullopt;
-}
-
-ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
-  for (const ViewerSource& source : scene.sources) {
-    if (source.name == name || std::filesystem::path(source.name).stem() == name) {
-      Camera camera = MakePinholeCamera(source.camera.id, source.camera.width, source.camera.height,
-                                        source.camera.FocalX(), source.camera.FocalY(),
-                                        source.camera.PrincipalX(), source.camera.PrincipalY());
-      return ViewCamera{camera, source.cam_from_world, 0};
     }
   }
   std::string known;
@@ -34,6 +24,21 @@ ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
   if (scene.sources.size() > 5) known += ", ...";
   throw BadInputError("--camera " + name + ": no source camera of that name or stem" +
                       (known.empty() ? " (the workspace has no sparse model)" : " (there are: " + known + ")"));
+}
+
+}  // namespace
+
+std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name) {
+  if (name.empty()) return std::nullopt;
+  return FindSource(scene, name);
+}
+
+ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
+  const ViewerSource& source = scene.sources[static_cast<size_t>(FindSource(scene, name))];
+  const Camera camera = MakePinholeCamera(source.camera.id, source.camera.width, source.camera.height,
+                                          source.camera.FocalX(), source.camera.FocalY(),
+                                          source.camera.PrincipalX(), source.camera.PrincipalY());
+  return ViewCamera{camera, source.cam_from_world, 0};
 }
 
 Orbit DefaultOrbit(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
