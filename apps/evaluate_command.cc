@@ -9,6 +9,7 @@
 #include "apps/terminal_progress.h"
 #include "core/atomic_file.h"
 #include "eval/workspace_evaluation.h"
+#include "pipeline/dense_stages.h"
 
 namespace parallax {
 namespace {
@@ -57,12 +58,15 @@ void PrintCloudAndMesh(const WorkspaceEvaluation& evaluation) {
   }
   if (evaluation.mesh) {
     const MeshEvaluation& mesh = *evaluation.mesh;
-    std::printf("mesh: %zu triangles; vertices: median relative distance %.3f%%, within 1%% "
-                "%.1f%%; textured renders: %.2f dB PSNR on %.1f%% covered pixels (%s)\n",
-                mesh.triangles, 100 * mesh.accuracy.median_relative_distance,
-                100 * mesh.accuracy.within_1pct, mesh.texture.psnr_mean,
-                100 * mesh.texture.coverage_mean, mesh.render_dir.string().c_str());
+    std::printf("mesh: %zu triangles", mesh.triangles);
+    if (mesh.accuracy) {
+      std::printf("; vertices: median relative distance %.3f%%, within 1%% %.1f%%",
+                  100 * mesh.accuracy->median_relative_distance, 100 * mesh.accuracy->within_1pct);
+    }
+    std::printf("; textured renders: %.2f dB PSNR on %.1f%% covered pixels (%s)\n",
+                mesh.texture.psnr_mean, 100 * mesh.texture.coverage_mean, mesh.render_dir.string().c_str());
   }
+  for (const std::string& line : evaluation.not_scored) std::printf("not scored: %s\n", line.c_str());
 }
 
 void PrintNovel(const NovelViewsEvaluation& novel) {
@@ -71,16 +75,19 @@ void PrintNovel(const NovelViewsEvaluation& novel) {
     std::printf("novel camera poses: %s\n", novel.registration_note.c_str());
   }
   if (!novel.gt_sources) std::printf("novel views: depth holes %s\n", novel.depth_holes_note.c_str());
-  std::printf("%-16s %9s %7s %14s %7s\n", "novel view", "PSNR (dB)", "SSIM", "sampled (dB)", "holes");
+  std::printf("%-16s %9s %7s %14s %16s %7s\n", "novel view", "PSNR (dB)", "SSIM", "sampled (dB)",
+              "exposure (dB)", "holes");
   for (const NovelViewScore& view : result.per_view) {
-    std::printf("%-16s %9.2f %7.3f %14.2f %6.2f%%\n", view.name.c_str(), view.psnr, view.ssim,
-                view.psnr_valid, 100 * view.hole_ratio);
+    std::printf("%-16s %9.2f %7.3f %14.2f %16.2f %6.2f%%\n", view.name.c_str(), view.psnr, view.ssim,
+                view.psnr_valid, view.psnr_exposure_matched, 100 * view.hole_ratio);
   }
-  std::printf("novel views (%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels), SSIM %.3f; "
+  std::printf("novel views (%s%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels, %.2f dB exposure "
+              "matched), SSIM %.3f; "
               "holes %.2f%% (cracks %.2f%%) -> %.2f%% after filling; out of view %.2f%%, "
               "background %.2f%%; %.1f ms per view; %d of %d sources loaded (%s)\n",
-              novel.gt_sources ? "ground-truth sources" : "workspace sources", result.views,
-              result.psnr_mean, result.psnr_valid_mean, result.ssim_mean,
+              novel.gt_sources ? "ground-truth sources" : "workspace sources",
+              novel.color_gains ? ", color gains" : "", result.views,
+              result.psnr_mean, result.psnr_valid_mean, result.psnr_exposure_matched_mean, result.ssim_mean,
               100 * result.hole_ratio_mean, 100 * result.crack_ratio_mean,
               100 * result.hole_ratio_filled_mean, 100 * result.out_of_view_ratio_mean,
               100 * result.background_ratio_mean, result.ms_per_view, result.sources_loaded,
@@ -133,6 +140,10 @@ void RegisterEvaluateCommand(CLI::App& app) {
     arguments->options.novel.Resolve();
     const Workspace workspace(arguments->workspace);
     WorkspaceEvaluation evaluation;
+    if (arguments->options.novel.color_gains && !arguments->options.gt_sources) {
+      const std::string note = EnsureColorGains(workspace);
+      if (!note.empty()) std::printf("%s\n", note.c_str());
+    }
     {
       TerminalProgress progress;
       evaluation = EvaluateWorkspace(workspace, SceneFolder{arguments->scene}, arguments->options,

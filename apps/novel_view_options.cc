@@ -17,6 +17,9 @@ void AddNovelViewOptions(CLI::App& command, NovelViewSettings& settings) {
                      "the reconstruction's mesh (mesh, default, when reconstruct made one) or "
                      "leave them holes (none)")
       ->transform(CLI::CheckedTransformer(depth_holes, CLI::ignore_case));
+  command.add_flag("--no-color-gains{false}", settings.color_gains,
+                   "workspace sources: blend the photos as they are, without correcting each "
+                   "one's exposure and white balance (color_gains.json, estimated by reconstruct)");
   command.add_option("--sources", settings.selection.num_sources,
                      "source views per novel view: the best K by overlap and angle (default 4)")
       ->check(CLI::Range(1, 64));

@@ -33,6 +33,7 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
                 summary.plausibility.focal_px, summary.plausibility.focal_prior_px,
                 summary.plausibility.median_triangulation_deg);
   }
+  for (const std::string& line : summary.depth_resolution) std::printf("depth: %s\n", line.c_str());
   for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
   for (const std::string& warning : summary.warnings) {
     std::fprintf(stderr, "WARNING: %s\n", warning.c_str());
@@ -94,10 +95,16 @@ void RegisterReconstructCommand(CLI::App& app) {
   command->add_option("--mvs-sources", arguments->options.mvs_sources,
                       "source views per depth map (default: as --quality says: 3, 5, 7)")
       ->check(CLI::Range(1, 32));
-  command->add_option("--mvs-scale", arguments->options.mvs_scale,
-                      "resolution of the depth estimate as a share of each photo side (default 1; "
-                      "0.5 is about 4x faster; depth maps are written at the photo's size)")
-      ->check(CLI::Range(0.25, 1.0));
+  CLI::Option* scale = command->add_option(
+      "--mvs-scale", arguments->options.mvs_scale,
+      "resolution of the depth estimate as a share of each photo side, no cap (1: full size; "
+      "default: as --quality caps the long side: 768, 1024, 1600 px; depth maps are always "
+      "written at the photo's size)");
+  scale->check(CLI::Range(0.25, 1.0));
+  command->add_option("--mvs-max-size", arguments->options.mvs_max_size,
+                      "cap on the long side of the depth estimate, in pixels (default: as --quality says)")
+      ->check(CLI::Range(64, 100000))
+      ->excludes(scale);
   command->add_flag("--no-mesh", arguments->no_mesh,
                     "stop after depth maps and the fused cloud (no textured mesh)");
   command->add_flag("--strict", arguments->options.strict,

@@ -1,7 +1,9 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -31,6 +33,7 @@ class Bench {
  public:
   Bench(fs::path scene, fs::path out) : scene_{std::move(scene)}, out_(std::move(out)) {
     self_ = fs::read_symlink("/proc/self/exe").string();
+    real_ = !fs::is_directory(scene_.Training().depth);
     fs::create_directories(out_ / "logs");
   }
 
@@ -80,6 +83,8 @@ class Bench {
   void LeaveOut();
 
   const fs::path& Out() const { return out_; }
+  // Real photos: ground-truth cameras and held-out photos, no ground-truth depth.
+  bool Real() const { return real_; }
   std::vector<BenchRow> rows;
   std::vector<std::string> leave_out;
 
@@ -90,7 +95,16 @@ class Bench {
   SceneFolder scene_;
   fs::path out_;
   std::string self_;
+  bool real_ = false;
 };
+
+// The mean share of each view's pixels whose depth survived the geometric filter (the depth
+// section of report.json).
+double MeanGeometricShare(const nlohmann::json& depth) {
+  double sum = 0;
+  for (const nlohmann::json& view : depth.at("views")) sum += view.at("geometric_share").get<double>();
+  return depth.at("views").empty() ? 0.0 : sum / static_cast<double>(depth.at("views").size());
+}
 
 double At(const nlohmann::json& json, const std::string& section, const std::string& key,
           const std::string& sub = "") {
@@ -141,7 +155,16 @@ void Bench::Depth() {
     std::vector<std::string> flags;
     bool baseline = false;
   };
-  const std::vector<Setting> settings = {
+  // Real photos: the working resolution is the knob that matters (docs/depth.md).
+  const std::vector<Setting> real_settings = {
+      {"fast", "patchmatch", "quality=fast (768 px)", {"--quality", "fast"}},
+      {"balanced_768", "patchmatch", "quality=balanced 768 px", {"--mvs-max-size", "768"}},
+      {"balanced", "patchmatch", "quality=balanced (1024 px)", {"--quality", "balanced"}},
+      {"balanced_1536", "patchmatch", "quality=balanced 1536 px", {"--mvs-max-size", "1536"}},
+      {"balanced_full", "patchmatch", "quality=balanced full size", {"--mvs-scale", "1"}},
+      {"best", "patchmatch", "quality=best (1600 px)", {"--quality", "best"}},
+      {"sgbm", "sgbm", "OpenCV StereoSGBM, rectified pairs", {"--stereo", "sgbm"}, true}};
+  const std::vector<Setting> synthetic_settings = {
       {"fast", "patchmatch", "quality=fast sources=3", {"--quality", "fast"}},
       {"balanced", "patchmatch", "quality=balanced sources=5", {"--quality", "balanced"}},
       {"best", "patchmatch", "quality=best sources=7", {"--quality", "best"}},
@@ -150,8 +173,12 @@ void Bench::Depth() {
       {"balanced_half", "patchmatch", "quality=balanced sources=5 scale=0.5", {"--mvs-scale", "0.5"}},
       {"fast_half", "patchmatch", "quality=fast sources=3 scale=0.5", {"--quality", "fast", "--mvs-scale", "0.5"}},
       {"sgbm", "sgbm", "OpenCV StereoSGBM, rectified pairs", {"--stereo", "sgbm"}, true}};
-  const int views = static_cast<int>(ReadSparseModel(scene_.Training().sparse).Images().size());
+  const std::vector<Setting>& settings = real_ ? real_settings : synthetic_settings;
+  const SparseModel truth = ReadSparseModel(scene_.Training().sparse);
+  const int views = static_cast<int>(truth.Images().size());
+  const uint64_t long_side = std::max(truth.Cameras().front().width, truth.Cameras().front().height);
   for (const Setting& setting : settings) {
+    if (setting.id == "balanced_1536" && long_side <= 1536) continue;  // The same as full size.
     const fs::path workspace = out_ / ("depth_" + setting.id);
     fs::remove_all(workspace);
     fs::copy(base, workspace, fs::copy_options::recursive);
@@ -162,14 +189,19 @@ void Bench::Depth() {
     const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(Workspace(workspace).Report()));
     const double depth_seconds = report.at("reconstruct").at("timings_s").at("depth").get<double>();
     const nlohmann::json json = Evaluate("depth_" + setting.id + "_eval", workspace, {"--no-align"});
-    rows.push_back({"depth", setting.method, setting.label,
-                    {{"abs_rel_median", At(json, "depth", "abs_rel_median")},
-                     {"signed_median", At(json, "depth", "signed_median")},
-                     {"within_2pct", At(json, "depth", "within_2pct")},
-                     {"completeness", At(json, "depth", "completeness")},
-                     {"novel_psnr", At(json, "novel", "psnr_mean")},
-                     {"novel_ssim", At(json, "novel", "ssim_mean")}},
-                    depth_seconds / views, run.wall_s, run.peak_mb, setting.baseline});
+    std::map<std::string, double> metrics = {{"novel_psnr", At(json, "novel", "psnr_mean")},
+                                             {"novel_ssim", At(json, "novel", "ssim_mean")}};
+    if (real_) {
+      // No true depth: the held-out photos, and how much of each depth map its neighbours confirm.
+      metrics["novel_psnr_exposure_matched"] = At(json, "novel", "psnr_exposure_matched_mean");
+      metrics["consistent_share"] = MeanGeometricShare(report.at("reconstruct").at("depth"));
+    } else {
+      for (const char* key : {"abs_rel_median", "signed_median", "within_2pct", "completeness"}) {
+        metrics[key] = At(json, "depth", key);
+      }
+    }
+    rows.push_back({"depth", setting.method, setting.label, metrics, depth_seconds / views, run.wall_s,
+                    run.peak_mb, setting.baseline});
   }
 }
 
@@ -182,6 +214,7 @@ void Bench::Render() {
     int hole_sources = 0;
     bool baseline = false;
     std::string texture_filter = "auto";  // render --texture-filter.
+    bool color_gains = true;               // Without: --no-color-gains.
   };
   std::vector<Setting> settings;
   for (const std::string warp : {"mesh", "splat"}) {
@@ -193,26 +226,39 @@ void Bench::Render() {
   settings.push_back({"mesh", 4, "none"});
   settings.push_back({"mesh", 4, "inpaint"});
   settings.push_back({"naive", 1, "inpaint", 0, true});
+  if (real_) {
+    // Each evaluation renders full-size held-out photos: the knobs that matter on them only.
+    settings = {{"mesh", 1, "depth-aware"}, {"mesh", 2, "depth-aware"}, {"mesh", 4, "depth-aware", 2},
+                {"mesh", 4, "depth-aware", 2}, {"mesh", 4, "none"}, {"naive", 1, "inpaint", 0, true}};
+    settings[3].color_gains = false;
+  }
   for (const Setting& setting : settings) {
     const bool bicubic = setting.texture_filter != "auto";
     const std::string id = setting.warp + "_k" + std::to_string(setting.sources) + "_h" +
                            std::to_string(setting.hole_sources) + "_" + setting.fill +
-                           (bicubic ? "_" + setting.texture_filter : "");
+                           (bicubic ? "_" + setting.texture_filter : "") +
+                           (setting.color_gains ? "" : "_no_gains");
+    // Synthetic scenes: from the true depth, the warp apart from the stereo. Real photos have
+    // none: from the balanced depth maps, to the held-out photos.
+    std::vector<std::string> flags = {"--novel-only", "--sources", std::to_string(setting.sources),
+                                      "--hole-sources", std::to_string(setting.hole_sources), "--warp",
+                                      setting.warp, "--fill", setting.fill, "--texture-filter",
+                                      setting.texture_filter};
+    flags.push_back(real_ ? "--no-align" : "--gt-sources");
+    if (!setting.color_gains) flags.push_back("--no-color-gains");
     ChildRun run;
-    const nlohmann::json json = Evaluate(
-        "render_" + id, KnownWorkspace(),
-        {"--gt-sources", "--novel-only", "--sources", std::to_string(setting.sources),
-         "--hole-sources", std::to_string(setting.hole_sources), "--warp", setting.warp,
-         "--fill", setting.fill, "--texture-filter", setting.texture_filter},
-        &run);
+    const nlohmann::json json =
+        Evaluate("render_" + id, real_ ? out_ / "depth_balanced" : KnownWorkspace(), flags, &run);
     rows.push_back({"render", setting.baseline ? "naive" : "parallax",
                     "warp=" + setting.warp + " K=" + std::to_string(setting.sources) +
                         " hole-sources=" + std::to_string(setting.hole_sources) +
                         " fill=" + setting.fill +
-                        (bicubic ? " texture-filter=" + setting.texture_filter : ""),
+                        (bicubic ? " texture-filter=" + setting.texture_filter : "") +
+                        (setting.color_gains ? "" : " no-color-gains"),
                     {{"psnr", At(json, "novel", "psnr_mean")},
                      {"ssim", At(json, "novel", "ssim_mean")},
                      {"psnr_valid", At(json, "novel", "psnr_valid_mean")},
+                     {"psnr_exposure_matched", At(json, "novel", "psnr_exposure_matched_mean")},
                      {"hole_ratio", At(json, "novel", "hole_ratio_mean")}},
                     At(json, "novel", "ms_per_view"), run.wall_s, run.peak_mb, setting.baseline});
   }
@@ -295,20 +341,30 @@ BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir) {
   const SceneFolder scene{scene_dir};
   if (!fs::is_directory(scene.Training().sparse) || !fs::is_directory(scene.Novel().sparse)) {
     throw BadInputError(scene_dir.string() + " has no ground truth (gt/sparse, novel/sparse): "
-                        "bench needs a scene folder made by parallax synth");
+                        "bench needs a scene folder made by parallax synth, or real photos with "
+                        "ground-truth cameras and held-out photos (../shared/datasets)");
   }
   const auto start = std::chrono::steady_clock::now();
   Bench bench(scene_dir, out_dir);
   bench.StructureFromMotion();
   bench.Depth();
   bench.Render();
-  bench.Shadows();
+  if (bench.Real()) {
+    bench.leave_out.push_back("shadows: not measured on real photos (no synthetic light to ray trace "
+                              "against the viewer's); see the synthetic scene's report");
+  } else {
+    bench.Shadows();
+  }
   bench.LeaveOut();
-  const std::vector<BenchStage> stages = {
+  std::vector<BenchStage> stages = {
       {"sfm", "rotation_error_deg", "rotation error (deg)", false, "s"},
       {"depth", "within_2pct", "within 2% (share)", true, "s per view"},
       {"render", "psnr", "PSNR (dB)", true, "ms per view"},
       {"shadows", "iou_cast", "cast-shadow IoU vs Embree", true, "ms per frame (light moving)"}};
+  if (bench.Real()) {
+    stages[1] = {"depth", "novel_psnr", "held-out photo PSNR (dB)", true, "s per view"};
+    stages.pop_back();
+  }
   BenchSummary summary;
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary.runs = bench.rows.size();

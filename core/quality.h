@@ -6,4 +6,14 @@ namespace parallax {
 // documents what each level means for it.
 enum class Quality { kFast, kBalanced, kBest };
 
+// "fast", "balanced", "best": the name --quality takes.
+inline const char* QualityName(Quality quality) {
+  switch (quality) {
+    case Quality::kFast: return "fast";
+    case Quality::kBalanced: return "balanced";
+    case Quality::kBest: return "best";
+  }
+  return "balanced";
+}
+
 }  // namespace parallax

@@ -11,6 +11,9 @@ struct ViewSetPaths {
   std::filesystem::path sparse;  // COLMAP text model (points3D.txt empty)
   std::filesystem::path depth;   // <stem>.exr, float32 z-depth, 0 = background
   std::filesystem::path normal;  // <stem>.exr, optional, camera-frame unit normals
+  // Optional per-photo color gains (core/color_gains.h) applied as the photos are read;
+  // empty or missing: none.
+  std::filesystem::path color_gains;
 
   std::filesystem::path DepthFor(const std::string& image_name) const;
   std::filesystem::path NormalFor(const std::string& image_name) const;

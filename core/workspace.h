@@ -28,6 +28,12 @@ class Workspace {
   std::filesystem::path StereoDepthMap(const std::string& photo, StereoPass pass) const;
   std::filesystem::path StereoNormalMap(const std::string& photo, StereoPass pass) const;
   std::filesystem::path StereoConfig(const std::string& file) const { return Stereo() / file; }
+  // The depth stage's photometric estimates at the working resolution, between its two
+  // passes (removed when the stage ends): stereo/estimates/<photo>.bin.
+  std::filesystem::path StereoEstimates() const { return Stereo() / "estimates"; }
+  std::filesystem::path StereoEstimate(const std::string& photo) const {
+    return StereoEstimates() / (photo + ".bin");
+  }
 
   // Structure from motion's own files: the COLMAP database, the raw (distorted) models.
   std::filesystem::path Sfm() const { return root_ / "sfm"; }
@@ -45,6 +51,9 @@ class Workspace {
   std::filesystem::path Depth(const std::string& photo) const;
   std::filesystem::path DepthConfidence(const std::string& photo) const;
   std::filesystem::path DepthViews() const { return DepthDir() / "views.json"; }
+
+  // Per-photo exposure and white balance correction (core/color_gains.h).
+  std::filesystem::path ColorGainsFile() const { return root_ / "color_gains.json"; }
 
   std::filesystem::path Fused() const { return root_ / "fused.ply"; }
   std::filesystem::path PoissonMesh() const { return root_ / "mesh_poisson.ply"; }

@@ -1,9 +1,12 @@
 #include "eval/novel_evaluation.h"
 
+#include <array>
+
 #include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
+#include "core/color_gains.h"
 #include "core/image.h"
 #include "core/image_metrics.h"
 
@@ -40,6 +43,26 @@ Image SideBySide(const Image& render, const Image& truth, const ClassMap& classe
   return out;
 }
 
+// `render` (linear) times the per-channel gain that fits it best to `truth` (sRGB) where
+// `mask` is set, in sRGB.
+Image ExposureMatched(const Image& render, const Image& truth, const std::vector<uint8_t>& mask) {
+  const Image truth_linear = SrgbToLinear(truth);
+  std::array<double, 3> cross{0, 0, 0}, square{0, 0, 0};
+  for (size_t p = 0; p < mask.size(); ++p) {
+    if (!mask[p]) continue;
+    for (size_t c = 0; c < 3; ++c) {
+      const double r = render.Pixels()[3 * p + c];
+      cross[c] += r * truth_linear.Pixels()[truth_linear.Channels() * p + c];
+      square[c] += r * r;
+    }
+  }
+  RgbGain gain;
+  for (size_t c = 0; c < 3; ++c) gain[c] = square[c] > 0 ? static_cast<float>(cross[c] / square[c]) : 1.0f;
+  Image matched = render;
+  ApplyGain(gain, matched);
+  return LinearToSrgb(matched);
+}
+
 }  // namespace
 
 NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<NamedCamera>& targets,
@@ -66,11 +89,14 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
     }
     const HoleMetrics& metrics = view.result.metrics;
     const NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
-                               Psnr(render, truth_image, sampled), metrics.hole_ratio};
+                               Psnr(render, truth_image, sampled),
+                               Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
+                               metrics.hole_ratio};
     evaluation.per_view.push_back(score);
     evaluation.psnr_mean += score.psnr;
     evaluation.ssim_mean += score.ssim;
     evaluation.psnr_valid_mean += score.psnr_valid;
+    evaluation.psnr_exposure_matched_mean += score.psnr_exposure_matched;
     evaluation.hole_ratio_mean += metrics.hole_ratio;
     evaluation.crack_ratio_mean += metrics.crack_ratio;
     evaluation.out_of_view_ratio_mean += metrics.out_of_view_ratio;
@@ -87,6 +113,7 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
   if (evaluation.views > 0) {
     const double n = evaluation.views;
     for (double* mean : {&evaluation.psnr_mean, &evaluation.ssim_mean, &evaluation.psnr_valid_mean,
+                         &evaluation.psnr_exposure_matched_mean,
                          &evaluation.hole_ratio_mean, &evaluation.crack_ratio_mean,
                          &evaluation.out_of_view_ratio_mean, &evaluation.background_ratio_mean,
                          &evaluation.hole_ratio_filled_mean, &evaluation.ms_per_view}) {

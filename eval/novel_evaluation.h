@@ -16,6 +16,7 @@ struct NovelViewScore {
   double psnr = 0;
   double ssim = 0;
   double psnr_valid = 0;
+  double psnr_exposure_matched = 0;
   double hole_ratio = 0;
 };
 
@@ -25,6 +26,10 @@ struct NovelEvaluation {
   double psnr_mean = 0;        // All pixels, after filling (sRGB in [0, 1]).
   double ssim_mean = 0;        // All pixels, after filling.
   double psnr_valid_mean = 0;  // Pixels a sample landed on (surface or background), before filling.
+  // All pixels, after the render's exposure and white balance are matched to the photo's (one
+  // gain per channel, least squares over the sampled pixels in linear light), as real-photo
+  // benchmarks do: a held-out photo's own auto exposure cannot be known from the others.
+  double psnr_exposure_matched_mean = 0;
   double hole_ratio_mean = 0;
   double crack_ratio_mean = 0;
   double out_of_view_ratio_mean = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <exception>
+#include <map>
 #include <vector>
 
 #include "core/atomic_file.h"
@@ -16,25 +17,53 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Copies the database into `work_dir`, adds the photos' features and their matches with every
-// registered image, and registers them into a copy of `raw_model` at <work_dir>/model.
-// Throws ToolError when colmap fails.
+// The names the held-out photos are registered under: each with a prefix that no image of the
+// database starts with, so a held-out photo named like a training photo is still told apart.
+std::map<std::string, std::string> StagedNames(const std::vector<std::string>& names,
+                                               const std::map<std::string, DatabaseImage>& in_database) {
+  std::string prefix = "held-out-";
+  const auto taken = [&](const std::string& candidate) {
+    return std::any_of(in_database.begin(), in_database.end(),
+                       [&](const auto& image) { return image.first.starts_with(candidate); });
+  };
+  while (taken(prefix)) prefix += "x";
+  std::map<std::string, std::string> staged;
+  for (const std::string& name : names) staged[name] = prefix + fs::path(name).filename().string();
+  return staged;
+}
+
+// Links (or copies) each photo into <work_dir>/photos under its staged name.
+void StagePhotos(const fs::path& images_dir, const std::map<std::string, std::string>& staged,
+                 const fs::path& photos_dir) {
+  fs::create_directories(photos_dir);
+  for (const auto& [name, staged_name] : staged) {
+    std::error_code error;
+    fs::create_hard_link(images_dir / name, photos_dir / staged_name, error);
+    if (error) fs::copy_file(images_dir / name, photos_dir / staged_name);
+  }
+}
+
+// Copies the database into `work_dir`, adds the photos' features (under their staged names)
+// and their matches with every registered image, and registers them into a copy of
+// `raw_model` at <work_dir>/model. Throws ToolError when colmap fails.
 void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, const SparseModel& model,
-                        const fs::path& images_dir, const std::vector<std::string>& names,
+                        const fs::path& images_dir, const std::map<std::string, std::string>& staged,
                         const std::string& list, const std::string& pairs, const fs::path& work_dir,
                         Progress& progress) {
   const fs::path registered = work_dir / "model";
   fs::remove_all(work_dir);
   fs::create_directories(registered);
+  const fs::path photos_dir = work_dir / "photos";
+  StagePhotos(images_dir, staged, photos_dir);
   const fs::path db = work_dir / "database.db";
   fs::copy_file(database, db);
   WriteFileAtomically(work_dir / "image_list.txt", list);
   WriteFileAtomically(work_dir / "pairs.txt", pairs);
   const Colmap colmap;
   const fs::path log = work_dir / "colmap.log";
-  const int count = static_cast<int>(names.size());
+  const int count = static_cast<int>(staged.size());
   std::vector<std::string> extract = {
-      "--database_path", db.string(), "--image_path", images_dir.string(),
+      "--database_path", db.string(), "--image_path", photos_dir.string(),
       "--image_list_path", (work_dir / "image_list.txt").string(),
       "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "2000",
       "--SiftExtraction.max_num_features", "4096"};
@@ -56,6 +85,7 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
               "--output_path", registered.string()},
              log, "held-out registration", count, progress);
   fs::remove(db);  // A copy of the workspace's, plus a few images: not worth keeping.
+  fs::remove_all(photos_dir);
 }
 
 }  // namespace
@@ -75,19 +105,17 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   const SparseModel model = ReadSparseModel(raw_model);
   // Photos the database holds already (registered or not) would be taken for these.
   const std::map<std::string, DatabaseImage> in_database = ReadDatabaseImages(database);
+  const std::map<std::string, std::string> staged = StagedNames(names, in_database);
   std::string pairs, list;
   Hasher key_hasher;
-  key_hasher.Add("held-out-1").Add(static_cast<uint64_t>(fs::file_size(database)));
+  key_hasher.Add("held-out-2").Add(static_cast<uint64_t>(fs::file_size(database)));
   std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
   std::sort(model_files.begin(), model_files.end());
   for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
   for (const std::string& name : names) {
-    if (in_database.contains(name)) {
-      result.note = name + " is also a training photo's name";
-      return result;
-    }
-    for (const SparseImage& image : model.Images()) pairs += name + " " + image.name + "\n";
-    list += name + "\n";
+    const std::string& staged_name = staged.at(name);
+    for (const SparseImage& image : model.Images()) pairs += staged_name + " " + image.name + "\n";
+    list += staged_name + "\n";
     key_hasher.Add(name).Add(ReadFileBytes(images_dir / name));
   }
   const std::string key = key_hasher.Hex();
@@ -97,7 +125,7 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
                      DetectSparseFormat(registered);
   if (!reuse) {
     try {
-      RegisterWithColmap(database, raw_model, model, images_dir, names, list, pairs, work_dir, progress);
+      RegisterWithColmap(database, raw_model, model, images_dir, staged, list, pairs, work_dir, progress);
       WriteFileAtomically(key_file, key);
     } catch (const std::exception& e) {
       result.note = std::string("colmap could not register them: ") + e.what();
@@ -105,9 +133,9 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
     }
   }
   const SparseModel with_held_out = ReadSparseModel(registered);
-  for (const SparseImage& image : with_held_out.Images()) {
-    if (std::find(names.begin(), names.end(), image.name) != names.end()) {
-      result.cam_from_world[image.name] = image.cam_from_world;
+  for (const auto& [name, staged_name] : staged) {
+    if (const SparseImage* image = with_held_out.FindImageByName(staged_name)) {
+      result.cam_from_world[name] = image->cam_from_world;
     }
   }
   result.note = std::to_string(result.cam_from_world.size()) + " of " +

@@ -24,8 +24,9 @@ struct HeldOutRegistration {
 // with a similarity instead carries the reconstruction's local pose errors into the
 // novel cameras. Work and logs go to `work_dir`; a second
 // call with the same photos (names and bytes), the same model and database size reuses the
-// result. Returns an empty map and the reason when the workspace has no database (e.g. made
-// from known cameras), a name is also one in the database, or COLMAP fails. The rendered
+// result. The photos are registered under prefixed names, so they may share names with
+// training photos. Returns an empty map and the reason when the workspace has no database
+// (e.g. made from known cameras) or COLMAP fails. The rendered
 // targets keep their own (ground-truth) intrinsics: the registration solves the pose with the
 // workspace's estimated camera.
 HeldOutRegistration RegisterHeldOutPhotos(const std::filesystem::path& workspace,

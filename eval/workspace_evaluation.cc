@@ -38,12 +38,14 @@ std::optional<std::map<std::string, double>> ReconstructTimings(const Workspace&
 
 MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estimate,
                             const SparseModel& truth, const SceneFolder& scene,
-                            const Similarity3d& truth_from_estimate) {
+                            const Similarity3d& truth_from_estimate, bool truth_depth) {
   const TriangleMesh mesh = ReadTexturedMesh(workspace.Mesh());
   MeshEvaluation result;
   result.triangles = mesh.triangles.size();
   result.vertices = mesh.vertices.size();
-  result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
+  if (truth_depth) {
+    result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
+  }
   result.render_dir = workspace.MeshRenders();
   result.texture = ScoreTexturedMesh(mesh, estimate, workspace.Images(), result.render_dir);
   return result;
@@ -85,7 +87,10 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
     }
     if (evaluation.poses_registered > 0) evaluation.poses = "registered";
   }
-  SourceLibrary library(options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root()));
+  ViewSetPaths source_paths = options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root());
+  if (!options.novel.color_gains) source_paths.color_gains.clear();
+  evaluation.color_gains = !source_paths.color_gains.empty() && fs::exists(source_paths.color_gains);
+  SourceLibrary library(source_paths);
   library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
   if (!options.gt_sources) {
     evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
@@ -113,7 +118,17 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
       options.align ? evaluation.poses.alignment.target_from_source : Similarity3d{};
 
   const bool has_depth = HasDepthMaps(workspace.DepthDir());
-  if (has_depth && !options.novel_only) {
+  // Real photos come with cameras but (usually) without depth: everything else is scored.
+  const bool truth_depth = fs::is_directory(scene.Training().depth);
+  if (!truth_depth && !options.novel_only) {
+    evaluation.not_scored.push_back("depth maps, fused cloud and mesh geometry: " + scene.root.string() +
+                                    " has no ground-truth depth (gt/depth)");
+  }
+  if (!truth_depth && options.gt_sources) {
+    throw BadInputError(scene.Training().depth.string() + " does not exist: --gt-sources renders "
+                        "from the scene's ground-truth depth, which this scene does not have");
+  }
+  if (has_depth && truth_depth && !options.novel_only) {
     evaluation.depth_aligned = options.align;
     evaluation.depth_error_dir = workspace.DepthErrorImages();
     DepthEvaluation depth = EvaluateDepth(estimate, workspace.DepthDir(), truth, scene.Training().depth,
@@ -124,12 +139,12 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
       evaluation.depth_without_truth = true;
     }
   }
-  if (fs::exists(workspace.Fused()) && !options.novel_only) {
+  if (fs::exists(workspace.Fused()) && truth_depth && !options.novel_only) {
     evaluation.fused = MeasureCloud(ReadPly(workspace.Fused()).vertices, truth,
                                     scene.Training().depth, truth_from_estimate);
   }
   if (fs::exists(workspace.Mesh()) && !options.novel_only) {
-    evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate);
+    evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate, truth_depth);
   }
   if (fs::is_directory(scene.Novel().sparse) && (options.gt_sources || has_depth)) {
     evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate, progress);
@@ -153,10 +168,12 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
     const MeshEvaluation& mesh = *evaluation.mesh;
     json["mesh"] = {{"triangles", mesh.triangles},
                     {"vertices", mesh.vertices},
-                    {"median_relative_distance", mesh.accuracy.median_relative_distance},
-                    {"within_1pct", mesh.accuracy.within_1pct},
                     {"textured_psnr_mean", mesh.texture.psnr_mean},
                     {"textured_coverage_mean", mesh.texture.coverage_mean}};
+    if (mesh.accuracy) {
+      json["mesh"]["median_relative_distance"] = mesh.accuracy->median_relative_distance;
+      json["mesh"]["within_1pct"] = mesh.accuracy->within_1pct;
+    }
   }
   if (evaluation.novel) {
     const NovelViewsEvaluation& novel = *evaluation.novel;
@@ -165,6 +182,7 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                      {"psnr_mean", result.psnr_mean},
                      {"ssim_mean", result.ssim_mean},
                      {"psnr_valid_mean", result.psnr_valid_mean},
+                     {"psnr_exposure_matched_mean", result.psnr_exposure_matched_mean},
                      {"hole_ratio_mean", result.hole_ratio_mean},
                      {"crack_ratio_mean", result.crack_ratio_mean},
                      {"out_of_view_ratio_mean", result.out_of_view_ratio_mean},
@@ -172,9 +190,11 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                      {"hole_ratio_filled_mean", result.hole_ratio_filled_mean},
                      {"ms_per_view", result.ms_per_view},
                      {"gt_sources", novel.gt_sources},
+                     {"color_gains", novel.color_gains},
                      {"poses", novel.poses},
                      {"poses_registered", novel.poses_registered}};
   }
+  if (!evaluation.not_scored.empty()) json["not_scored"] = evaluation.not_scored;
   if (evaluation.reconstruct_timings_s) json["timings_s"] = *evaluation.reconstruct_timings_s;
 }
 

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -41,7 +42,7 @@ struct EvaluateOptions {
 struct MeshEvaluation {
   size_t triangles = 0;
   size_t vertices = 0;
-  CloudAccuracy accuracy;     // Vertices against the ground-truth depth.
+  std::optional<CloudAccuracy> accuracy;  // Vertices against the ground-truth depth, if any.
   TexturedMeshScore texture;  // Renders from the workspace cameras against the photos.
   std::filesystem::path render_dir;
 };
@@ -49,6 +50,7 @@ struct MeshEvaluation {
 struct NovelViewsEvaluation {
   NovelEvaluation result;
   bool gt_sources = false;
+  bool color_gains = false;  // The sources' photos were corrected by the workspace's gains.
   std::string poses;  // "ground truth", "registered" or "aligned".
   int poses_registered = 0;
   bool registration_tried = false;
@@ -65,6 +67,9 @@ struct WorkspaceEvaluation {
   bool depth_without_truth = false;  // Depth maps exist, none of a ground-truth image.
   std::optional<CloudAccuracy> fused;
   std::optional<MeshEvaluation> mesh;
+  // What the scene has no ground truth for (e.g. real photos without depth), and so was not
+  // scored.
+  std::vector<std::string> not_scored;
   std::optional<NovelViewsEvaluation> novel;
   // Stage timings from reconstruct's report.json, when the workspace has them.
   std::optional<std::map<std::string, double>> reconstruct_timings_s;

@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "core/hash.h"
+#include "core/color_gains.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
@@ -95,12 +96,14 @@ TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius)
 std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
   const Workspace ws(workspace);
   const SparseModel model = ReadSparseModel(ws.Sparse());
+  const ColorGains gains = ReadWorkspaceColorGains(workspace);
   std::vector<TextureView> views;
   for (const SparseImage& image : model.Images()) {
     TextureView view;
     view.camera = model.CameraById(image.camera_id);
     view.cam_from_world = image.cam_from_world;
     view.color = SrgbToLinear(ReadImage(ws.Image(image.name)));
+    ApplyGain(gains.Of(image.name), view.color);
     views.push_back(std::move(view));
   }
   return views;

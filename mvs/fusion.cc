@@ -1,11 +1,16 @@
 #include "mvs/fusion.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
+#include <set>
 #include <cstring>
 #include <numbers>
 #include <stdexcept>
 
 #include "core/atomic_file.h"
+#include "core/color_gains.h"
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -23,8 +28,7 @@ struct FusionView {
   Eigen::Matrix3d world_from_cam;
   DepthMap depth;
   DenseArray normals;  // Camera frame, channel-major (COLMAP layout).
-  Image color;        // Linear RGB.
-  std::vector<uint8_t> used;
+  Image color;        // Linear RGB, corrected by the photo's color gain.
 
   size_t Pixels() const { return static_cast<size_t>(depth.Width()) * depth.Height(); }
   Eigen::Vector3d Normal(int x, int y) const {
@@ -33,37 +37,181 @@ struct FusionView {
   }
 };
 
-std::vector<FusionView> LoadViews(const fs::path& workspace) {
-  const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
-  std::vector<FusionView> views;
+// The model's images that have a depth map and a geometric normal map.
+std::vector<const SparseImage*> ViewsWithDepth(const Workspace& ws, const SparseModel& model) {
+  std::vector<const SparseImage*> views;
   for (const SparseImage& image : model.Images()) {
-    const fs::path depth_path = ws.Depth(image.name);
-    const fs::path normal_path = ws.StereoNormalMap(image.name, StereoPass::kGeometric);
-    if (!fs::exists(depth_path) || !fs::exists(normal_path)) continue;
+    if (fs::exists(ws.Depth(image.name)) && fs::exists(ws.StereoNormalMap(image.name, StereoPass::kGeometric))) {
+      views.push_back(&image);
+    }
+  }
+  return views;
+}
+
+// For each view, the `max_neighbours` others sharing the most sparse points with it (ties: the
+// earlier), in view order.
+std::vector<std::vector<size_t>> Neighbours(const SparseModel& model, const std::vector<const SparseImage*>& views,
+                                            int max_neighbours) {
+  std::map<uint32_t, size_t> index_of;
+  for (size_t i = 0; i < views.size(); ++i) index_of[views[i]->id] = i;
+  std::vector<std::vector<int>> shared(views.size(), std::vector<int>(views.size(), 0));
+  for (const Point3D& point : model.Points3D()) {
+    for (const TrackElement& a : point.track) {
+      for (const TrackElement& b : point.track) {
+        const auto ia = index_of.find(a.image_id), ib = index_of.find(b.image_id);
+        if (ia != index_of.end() && ib != index_of.end() && ia->second != ib->second) ++shared[ia->second][ib->second];
+      }
+    }
+  }
+  std::vector<std::vector<size_t>> neighbours(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    std::vector<size_t> others;
+    for (size_t j = 0; j < views.size(); ++j) {
+      if (j != i) others.push_back(j);
+    }
+    std::stable_sort(others.begin(), others.end(), [&](size_t a, size_t b) { return shared[i][a] > shared[i][b]; });
+    others.resize(std::min(others.size(), static_cast<size_t>(max_neighbours)));
+    std::sort(others.begin(), others.end());
+    neighbours[i] = std::move(others);
+  }
+  return neighbours;
+}
+
+// The views one reference fuses with, read from disk as needed and kept while they fit:
+// memory is bounded by `capacity` views whatever their number.
+class FusionViewCache {
+ public:
+  FusionViewCache(const Workspace& ws, const SparseModel& model, const std::vector<const SparseImage*>& views,
+                  size_t capacity)
+      : ws_(ws), model_(model), views_(views), gains_(ReadWorkspaceColorGains(ws.Root())), capacity_(capacity) {}
+
+  // Every view of `wanted` resident at once; pointers stay valid until the next call.
+  std::map<size_t, FusionView*> Acquire(const std::vector<size_t>& wanted) {
+    ++tick_;
+    const std::set<size_t> keep(wanted.begin(), wanted.end());
+    size_t missing = 0;
+    for (const size_t index : wanted) missing += resident_.count(index) ? 0 : 1;
+    while (resident_.size() + missing > std::max(capacity_, wanted.size()) && EvictOldestOutside(keep)) {
+    }
+    std::map<size_t, FusionView*> acquired;
+    for (const size_t index : wanted) {
+      Entry& entry = resident_[index];
+      if (!entry.view) entry.view = std::make_unique<FusionView>(Load(*views_[index]));
+      entry.last_used = tick_;
+      acquired[index] = entry.view.get();
+    }
+    return acquired;
+  }
+
+ private:
+  struct Entry {
+    std::unique_ptr<FusionView> view;
+    uint64_t last_used = 0;
+  };
+
+  bool EvictOldestOutside(const std::set<size_t>& keep) {
+    auto oldest = resident_.end();
+    for (auto it = resident_.begin(); it != resident_.end(); ++it) {
+      if (!keep.count(it->first) && (oldest == resident_.end() || it->second.last_used < oldest->second.last_used)) {
+        oldest = it;
+      }
+    }
+    if (oldest == resident_.end()) return false;
+    resident_.erase(oldest);
+    return true;
+  }
+
+  FusionView Load(const SparseImage& image) const {
     FusionView view;
-    view.camera = model.CameraById(image.camera_id);
+    view.camera = model_.CameraById(image.camera_id);
     view.cam_from_world = image.cam_from_world;
     view.world_from_cam = image.cam_from_world.rotation.conjugate().toRotationMatrix();
-    view.depth = ReadDepthExr(depth_path);
-    view.normals = ReadColmapArray(normal_path);
-    view.color = SrgbToLinear(ReadImage(ws.Image(image.name)));
+    view.depth = ReadDepthExr(ws_.Depth(image.name));
+    view.normals = ReadColmapArray(ws_.StereoNormalMap(image.name, StereoPass::kGeometric));
+    view.color = SrgbToLinear(ReadImage(ws_.Image(image.name)));
+    ApplyGain(gains_.Of(image.name), view.color);
     if (view.normals.width != view.depth.Width() || view.normals.height != view.depth.Height() ||
         view.normals.channels != 3 || view.color.Width() != view.depth.Width() ||
         view.color.Height() != view.depth.Height()) {
-      throw BadInputError("fusion: depth, normal map and image of " + image.name +
-                          " differ in size");
+      throw BadInputError("fusion: depth, normal map and image of " + image.name + " differ in size");
     }
-    view.used.assign(view.Pixels(), 0);
-    views.push_back(std::move(view));
+    return view;
   }
-  return views;
+
+  const Workspace& ws_;
+  const SparseModel& model_;
+  const std::vector<const SparseImage*>& views_;
+  const ColorGains gains_;
+  const size_t capacity_;
+  std::map<size_t, Entry> resident_;
+  uint64_t tick_ = 0;
+};
+
+// The pixels already merged into a point, one bit each, for every view (small enough to keep
+// for all of them).
+using UsedPixels = std::vector<std::vector<bool>>;
+
+// The reference's unused pixels, each merged with the neighbours' pixels that see the same
+// surface, appended to `points`.
+void FuseReference(size_t reference_index, const std::map<size_t, FusionView*>& views, const FusionOptions& options,
+                   UsedPixels& used, std::vector<FusedPoint>& points) {
+  const double min_normal_cos = std::cos(options.max_normal_angle_deg * std::numbers::pi / 180);
+  const FusionView& reference = *views.at(reference_index);
+  std::vector<bool>& reference_used = used[reference_index];
+  for (int y = 0; y < reference.depth.Height(); ++y) {
+    for (int x = 0; x < reference.depth.Width(); ++x) {
+      const size_t pixel = static_cast<size_t>(y) * reference.depth.Width() + x;
+      const float depth = reference.depth.At(x, y);
+      if (reference_used[pixel] || !(depth > 0)) continue;
+      reference_used[pixel] = true;
+      const Eigen::Vector3d point = reference.world_from_cam *
+          (*reference.camera.Unproject({x + 0.5, y + 0.5}, depth) - reference.cam_from_world.translation);
+      const Eigen::Vector3d normal = reference.world_from_cam * reference.Normal(x, y);
+      Eigen::Vector3d position_sum = point, normal_sum = normal, color_sum = Eigen::Vector3d::Zero();
+      for (int c = 0; c < 3; ++c) color_sum[c] = reference.color.At(x, y, c);
+      int count = 1;
+      for (const auto& [j, other] : views) {
+        if (j == reference_index) continue;
+        const Eigen::Vector3d in_other = other->cam_from_world * point;
+        const std::optional<Eigen::Vector2d> projected = other->camera.Project(in_other);
+        if (!projected) continue;
+        const int ox = static_cast<int>(std::floor(projected->x()));
+        const int oy = static_cast<int>(std::floor(projected->y()));
+        if (ox < 0 || oy < 0 || ox >= other->depth.Width() || oy >= other->depth.Height()) continue;
+        const size_t other_pixel = static_cast<size_t>(oy) * other->depth.Width() + ox;
+        const double other_depth = other->depth.At(ox, oy);
+        if (used[j][other_pixel] || !(other_depth > 0) ||
+            std::abs(other_depth - in_other.z()) > options.max_relative_depth * in_other.z()) {
+          continue;
+        }
+        const Eigen::Vector3d other_normal = other->world_from_cam * other->Normal(ox, oy);
+        if (other_normal.dot(normal) < min_normal_cos) continue;
+        used[j][other_pixel] = true;
+        position_sum += other->world_from_cam *
+            (*other->camera.Unproject({ox + 0.5, oy + 0.5}, other_depth) - other->cam_from_world.translation);
+        normal_sum += other_normal;
+        for (int c = 0; c < 3; ++c) color_sum[c] += static_cast<double>(other->color.At(ox, oy, c));
+        ++count;
+      }
+      if (count < options.min_views) continue;
+      FusedPoint fused;
+      fused.position = (position_sum / count).cast<float>();
+      fused.normal = normal_sum.normalized().cast<float>();
+      for (int c = 0; c < 3; ++c) {
+        const float encoded = LinearToSrgb(static_cast<float>(color_sum[c] / count));
+        fused.color[c] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255));
+      }
+      fused.views = static_cast<uint16_t>(std::min(count, 65535));
+      points.push_back(fused);
+    }
+  }
 }
 
 }  // namespace
 
 void FusionOptions::Check() const {
   RequireOption(min_views >= 1, "FusionOptions.min_views", min_views, ">= 1");
+  RequireOption(max_neighbours >= 1, "FusionOptions.max_neighbours", max_neighbours, ">= 1");
   RequireOption(max_relative_depth > 0, "FusionOptions.max_relative_depth", max_relative_depth, "> 0");
   RequireOption(max_normal_angle_deg > 0 && max_normal_angle_deg <= 180, "FusionOptions.max_normal_angle_deg",
                 max_normal_angle_deg, "(0, 180]");
@@ -72,62 +220,25 @@ void FusionOptions::Check() const {
 std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOptions& options,
                                       Progress& progress) {
   options.Check();
-  std::vector<FusionView> views = LoadViews(workspace);
-  const double min_normal_cos = std::cos(options.max_normal_angle_deg * std::numbers::pi / 180);
-  std::vector<FusedPoint> points;
+  const Workspace ws(workspace);
+  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const std::vector<const SparseImage*> views = ViewsWithDepth(ws, model);
+  const std::vector<std::vector<size_t>> neighbours = Neighbours(model, views, options.max_neighbours);
+  FusionViewCache cache(ws, model, views, static_cast<size_t>(options.max_neighbours) + 1);
+  UsedPixels used(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
-    progress.Update("fusion", static_cast<int64_t>(i), static_cast<int64_t>(views.size()));
-    FusionView& reference = views[i];
-    for (int y = 0; y < reference.depth.Height(); ++y) {
-      for (int x = 0; x < reference.depth.Width(); ++x) {
-        const size_t pixel = static_cast<size_t>(y) * reference.depth.Width() + x;
-        const float depth = reference.depth.At(x, y);
-        if (reference.used[pixel] || !(depth > 0)) continue;
-        reference.used[pixel] = 1;
-        const Eigen::Vector3d point = reference.world_from_cam *
-            (*reference.camera.Unproject({x + 0.5, y + 0.5}, depth) - reference.cam_from_world.translation);
-        const Eigen::Vector3d normal = reference.world_from_cam * reference.Normal(x, y);
-        Eigen::Vector3d position_sum = point, normal_sum = normal, color_sum = Eigen::Vector3d::Zero();
-        for (int c = 0; c < 3; ++c) color_sum[c] = reference.color.At(x, y, c);
-        int count = 1;
-        for (size_t j = 0; j < views.size(); ++j) {
-          if (j == i) continue;
-          FusionView& other = views[j];
-          const Eigen::Vector3d in_other = other.cam_from_world * point;
-          const std::optional<Eigen::Vector2d> projected = other.camera.Project(in_other);
-          if (!projected) continue;
-          const int ox = static_cast<int>(std::floor(projected->x()));
-          const int oy = static_cast<int>(std::floor(projected->y()));
-          if (ox < 0 || oy < 0 || ox >= other.depth.Width() || oy >= other.depth.Height()) continue;
-          const size_t other_pixel = static_cast<size_t>(oy) * other.depth.Width() + ox;
-          const double other_depth = other.depth.At(ox, oy);
-          if (other.used[other_pixel] || !(other_depth > 0) ||
-              std::abs(other_depth - in_other.z()) > options.max_relative_depth * in_other.z()) {
-            continue;
-          }
-          const Eigen::Vector3d other_normal = other.world_from_cam * other.Normal(ox, oy);
-          if (other_normal.dot(normal) < min_normal_cos) continue;
-          other.used[other_pixel] = 1;
-          position_sum += other.world_from_cam *
-              (*other.camera.Unproject({ox + 0.5, oy + 0.5}, other_depth) - other.cam_from_world.translation);
-          normal_sum += other_normal;
-          for (int c = 0; c < 3; ++c) color_sum[c] += static_cast<double>(other.color.At(ox, oy, c));
-          ++count;
-        }
-        if (count < options.min_views) continue;
-        FusedPoint fused;
-        fused.position = (position_sum / count).cast<float>();
-        fused.normal = normal_sum.normalized().cast<float>();
-        for (int c = 0; c < 3; ++c) {
-          const float encoded = LinearToSrgb(static_cast<float>(color_sum[c] / count));
-          fused.color[c] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255));
-        }
-        fused.views = static_cast<uint16_t>(std::min(count, 65535));
-        points.push_back(fused);
-      }
-    }
+    const Camera& camera = model.CameraById(views[i]->camera_id);
+    used[i].assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), false);
   }
-  progress.Update("fusion", static_cast<int64_t>(views.size()), static_cast<int64_t>(views.size()));
+  std::vector<FusedPoint> points;
+  const auto total = static_cast<int64_t>(views.size());
+  for (size_t i = 0; i < views.size(); ++i) {
+    progress.Update("fusion", static_cast<int64_t>(i), total);
+    std::vector<size_t> wanted = neighbours[i];
+    wanted.push_back(i);
+    FuseReference(i, cache.Acquire(wanted), options, used, points);
+  }
+  progress.Update("fusion", total, total);
   return points;
 }
 

@@ -20,6 +20,9 @@ struct FusionOptions {
   double max_relative_depth = 0.01;
   // ... and its normal within this angle (degrees).
   double max_normal_angle_deg = 20;
+  // Each view is merged with the views that share the most sparse points with it, at most
+  // this many; only they are in memory with it, so memory does not grow with the photo count.
+  int max_neighbours = 16;
   void Check() const;
 };
 
@@ -31,7 +34,9 @@ struct FusedPoint {
 };
 
 // Reads <ws>/sparse, <ws>/images, <ws>/depth/<stem>.exr and the geometric normal maps under
-// <ws>/stereo/normal_maps. Views without a depth map are left out. Deterministic.
+// <ws>/stereo/normal_maps (streamed: at most max_neighbours + 1 views in memory), colors
+// corrected by <ws>/color_gains.json when present. Views without a depth map are left out.
+// Deterministic.
 std::vector<FusedPoint> FuseWorkspace(const std::filesystem::path& workspace,
                                       const FusionOptions& options, Progress& progress);
 

@@ -33,21 +33,26 @@ GrayImage LoadGray(const fs::path& path) {
   return gray;
 }
 
-// The photo at `scale` of its size (area averaging, no aliasing), with its camera to match:
-// pixel coordinates (origin at the image corner) scale by the exact size ratio per axis.
-void ScaleView(StereoView& view, double scale) {
-  if (scale == 1) return;
-  const int width = std::max(1, static_cast<int>(std::lround(view.image.width * scale)));
-  const int height = std::max(1, static_cast<int>(std::lround(view.image.height * scale)));
-  const cv::Mat full(view.image.height, view.image.width, CV_32F, view.image.values.data());
+// The camera of a photo resampled to `scale` of its size: pixel coordinates (origin at the
+// image corner) scale by the exact size ratio per axis.
+Camera WorkingCamera(const Camera& camera, double scale) {
+  if (scale == 1) return camera;
+  const auto width = static_cast<uint64_t>(std::max(1L, std::lround(static_cast<double>(camera.width) * scale)));
+  const auto height = static_cast<uint64_t>(std::max(1L, std::lround(static_cast<double>(camera.height) * scale)));
+  const double sx = static_cast<double>(width) / static_cast<double>(camera.width);
+  const double sy = static_cast<double>(height) / static_cast<double>(camera.height);
+  return MakePinholeCamera(camera.id, width, height, camera.FocalX() * sx, camera.FocalY() * sy,
+                           camera.PrincipalX() * sx, camera.PrincipalY() * sy);
+}
+
+// The photo resampled to its working camera's size (area averaging, no aliasing).
+GrayImage ResampleTo(const GrayImage& image, const Camera& camera) {
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  if (image.width == width && image.height == height) return image;
+  const cv::Mat full(image.height, image.width, CV_32F, const_cast<float*>(image.values.data()));
   cv::Mat small;
   cv::resize(full, small, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  view.image = {width, height, std::vector<float>(small.begin<float>(), small.end<float>())};
-  const double sx = static_cast<double>(width) / static_cast<double>(view.camera.width);
-  const double sy = static_cast<double>(height) / static_cast<double>(view.camera.height);
-  view.camera = MakePinholeCamera(view.camera.id, static_cast<uint64_t>(width), static_cast<uint64_t>(height),
-                                  view.camera.FocalX() * sx, view.camera.FocalY() * sy,
-                                  view.camera.PrincipalX() * sx, view.camera.PrincipalY() * sy);
+  return {width, height, std::vector<float>(small.begin<float>(), small.end<float>())};
 }
 
 // Back to the photo's size, nearest: for each pixel of a width x height image (row-major), the
@@ -112,10 +117,28 @@ void MvsOptions::Check() const {
   filter.Check();
   RequireOption(filter_sources >= 1, "MvsOptions.filter_sources", filter_sources, ">= 1");
   RequireOption(image_scale >= 0.25 && image_scale <= 1, "MvsOptions.image_scale", image_scale, "[0.25, 1]");
+  RequireOption(max_image_size == 0 || max_image_size >= 64, "MvsOptions.max_image_size", max_image_size,
+                "0 (no cap) or >= 64");
+}
+
+double MvsOptions::ScaleFor(int width, int height) const {
+  const int long_side = std::max(width, height);
+  if (max_image_size == 0 || long_side <= 0) return image_scale;
+  return std::min(image_scale, static_cast<double>(max_image_size) / static_cast<double>(long_side));
+}
+
+int MaxImageSizeFor(Quality quality) {
+  switch (quality) {
+    case Quality::kFast: return 768;
+    case Quality::kBalanced: return 1024;
+    case Quality::kBest: return 1600;
+  }
+  return 0;
 }
 
 MvsOptions MvsOptionsFor(Quality quality) {
   MvsOptions options;
+  options.max_image_size = MaxImageSizeFor(quality);
   switch (quality) {
     case Quality::kFast:
       options.views.max_sources = 3;
@@ -196,42 +219,75 @@ std::vector<std::string> SkippedViews(const SparseModel& model, const DepthPlan&
   return skipped;
 }
 
-// Every image that takes part, as reference or as source, loaded once at the estimate's scale.
+// The views a reference needs (itself and its sources) at the working resolution; those
+// `previous` already holds are moved over, not loaded again, so consecutive references share
+// their common sources and no more than one reference's views are in memory.
 std::map<uint32_t, StereoView> LoadStereoViews(const Workspace& ws, const SparseModel& model,
-                                               const std::vector<ViewPlan>& plans, double scale) {
+                                               const ViewPlan& plan, const MvsOptions& options,
+                                               std::map<uint32_t, StereoView>& previous) {
   std::map<uint32_t, StereoView> views;
-  for (const ViewPlan& plan : plans) {
-    for (uint32_t id : plan.sources) views[id];
-    views[plan.image_id];
-  }
-  for (auto& [id, view] : views) {
+  std::vector<uint32_t> ids = plan.sources;
+  ids.push_back(plan.image_id);
+  for (const uint32_t id : ids) {
+    if (const auto found = previous.find(id); found != previous.end()) {
+      views[id] = std::move(found->second);
+      continue;
+    }
     const SparseImage& image = model.ImageById(id);
-    view.camera = model.CameraById(image.camera_id);
+    const Camera& camera = model.CameraById(image.camera_id);
+    StereoView& view = views[id];
+    view.camera = WorkingCamera(camera, options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
     view.cam_from_world = image.cam_from_world;
-    view.image = LoadGray(ws.Image(image.name));
-    ScaleView(view, scale);
+    view.image = ResampleTo(LoadGray(ws.Image(image.name)), view.camera);
   }
+  previous.clear();
   return views;
 }
 
-std::map<uint32_t, DepthNormalMap> EstimatePhotometric(const std::map<uint32_t, StereoView>& views,
-                                                       const std::vector<ViewPlan>& plans,
-                                                       const PatchMatchOptions& options, Progress& progress) {
-  std::map<uint32_t, DepthNormalMap> estimates;
+// A photometric estimate between the passes: depth, normal (3) and cost planes.
+void WriteEstimate(const std::filesystem::path& path, const DepthNormalMap& estimate) {
+  const size_t pixels = estimate.depth.Values().size();
+  DenseArray array{estimate.depth.Width(), estimate.depth.Height(), 5, std::vector<float>(5 * pixels)};
+  for (size_t i = 0; i < pixels; ++i) {
+    array.values[i] = estimate.depth.Values()[i];
+    for (size_t c = 0; c < 3; ++c) array.values[(1 + c) * pixels + i] = estimate.normal[3 * i + c];
+    array.values[4 * pixels + i] = estimate.cost[i];
+  }
+  WriteColmapArray(path, array);
+}
+
+DepthNormalMap ReadEstimate(const std::filesystem::path& path) {
+  const DenseArray array = ReadColmapArray(path);
+  if (array.channels != 5) throw BadInputError(path.string() + ": not a depth-stage estimate");
+  const size_t pixels = static_cast<size_t>(array.width) * static_cast<size_t>(array.height);
+  DepthNormalMap estimate{DepthMap(array.width, array.height), std::vector<float>(3 * pixels),
+                          std::vector<float>(pixels)};
+  for (size_t i = 0; i < pixels; ++i) {
+    estimate.depth.Values()[i] = array.values[i];
+    for (size_t c = 0; c < 3; ++c) estimate.normal[3 * i + c] = array.values[(1 + c) * pixels + i];
+    estimate.cost[i] = array.values[4 * pixels + i];
+  }
+  return estimate;
+}
+
+// PatchMatch on every planned view, each estimate written to <ws>/stereo/estimates.
+void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const std::vector<ViewPlan>& plans,
+                         const MvsOptions& options, Progress& progress) {
+  std::map<uint32_t, StereoView> views;
   const auto total = static_cast<int64_t>(plans.size());
   for (size_t i = 0; i < plans.size(); ++i) {
     progress.Update("depth", static_cast<int64_t>(i), total);
     const ViewPlan& plan = plans[i];
+    views = LoadStereoViews(ws, model, plan, options, views);
     std::vector<const StereoView*> sources;
     for (uint32_t id : plan.sources) sources.push_back(&views.at(id));
-    PatchMatchOptions patch_match = options;
+    PatchMatchOptions patch_match = options.patch_match;
     patch_match.min_depth = plan.min_depth;
     patch_match.max_depth = plan.max_depth;
     patch_match.seed = plan.image_id;
-    estimates[plan.image_id] = PatchMatchStereo(views.at(plan.image_id), sources, patch_match);
+    WriteEstimate(ws.StereoEstimate(plan.name), PatchMatchStereo(views.at(plan.image_id), sources, patch_match));
   }
   progress.Update("depth", total, total);
-  return estimates;
 }
 
 // The view's maps in both formats, at the photo's size whatever the resolution of the estimate;
@@ -258,6 +314,46 @@ void WriteViewDepth(const Workspace& ws, const Camera& camera, const DepthNormal
   report.geometric_share = ValidShare(filtered.depth);
 }
 
+// The geometric pass for one view: its estimate checked against its sources' (read back from
+// <ws>/stereo/estimates), written in both formats. Needs no images, only cameras and poses.
+MvsViewReport FilterAndWriteView(const Workspace& ws, const SparseModel& model, const ViewPlan& view,
+                                 const std::set<std::string>& estimated, const MvsOptions& options) {
+  const auto working_view = [&](uint32_t id) {
+    const SparseImage& image = model.ImageById(id);
+    const Camera& camera = model.CameraById(image.camera_id);
+    StereoView stereo_view;
+    stereo_view.camera =
+        WorkingCamera(camera, options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+    stereo_view.cam_from_world = image.cam_from_world;
+    return stereo_view;
+  };
+  std::vector<StereoView> source_views;
+  std::vector<DepthNormalMap> source_estimates;
+  for (const uint32_t id : view.sources) {
+    const std::string& name = model.ImageById(id).name;
+    if (!estimated.count(name)) continue;
+    source_views.push_back(working_view(id));
+    source_estimates.push_back(ReadEstimate(ws.StereoEstimate(name)));
+  }
+  std::vector<std::pair<const StereoView*, const DepthNormalMap*>> sources;
+  for (size_t s = 0; s < source_views.size(); ++s) sources.emplace_back(&source_views[s], &source_estimates[s]);
+  const DepthNormalMap low = ReadEstimate(ws.StereoEstimate(view.name));
+  FilteredDepth filtered =
+      sources.empty() ? FilteredDepth{DepthMap(low.depth.Width(), low.depth.Height()),
+                                      DepthMap(low.depth.Width(), low.depth.Height())}
+                      : FilterGeometric(working_view(view.image_id), low, sources, options.filter);
+  MvsViewReport report;
+  report.name = view.name;
+  for (uint32_t id : view.sources) report.sources.push_back(model.ImageById(id).name);
+  report.min_depth = view.min_depth;
+  report.max_depth = view.max_depth;
+  report.working_width = low.depth.Width();
+  report.working_height = low.depth.Height();
+  const Camera& camera = model.CameraById(model.ImageById(view.image_id).camera_id);
+  WriteViewDepth(ws, camera, low, std::move(filtered), report);
+  return report;
+}
+
 }  // namespace
 
 MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& options,
@@ -269,38 +365,24 @@ MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& optio
   MvsSummary summary;
   summary.estimated_views = static_cast<int>(plan.estimated.size());
   summary.skipped = SkippedViews(model, plan);
-  const std::map<uint32_t, StereoView> views = LoadStereoViews(ws, model, plan.estimated, options.image_scale);
+  fs::remove_all(ws.StereoEstimates());
+  fs::create_directories(ws.StereoEstimates());
 
   auto start = std::chrono::steady_clock::now();
-  const std::map<uint32_t, DepthNormalMap> estimates =
-      EstimatePhotometric(views, plan.estimated, options.patch_match, progress);
+  EstimatePhotometric(ws, model, plan.estimated, options, progress);
   summary.photometric_seconds = Seconds(start);
 
   start = std::chrono::steady_clock::now();
+  std::set<std::string> estimated;
+  for (const ViewPlan& view : plan.estimated) estimated.insert(view.name);
   const auto total = static_cast<int64_t>(plan.written.size());
   for (size_t i = 0; i < plan.written.size(); ++i) {
     progress.Update("filter", static_cast<int64_t>(i), total);
-    const ViewPlan& view = plan.written[i];
-    std::vector<std::pair<const StereoView*, const DepthNormalMap*>> sources;
-    for (uint32_t id : view.sources) {
-      if (estimates.count(id)) sources.emplace_back(&views.at(id), &estimates.at(id));
-    }
-    const DepthNormalMap& low = estimates.at(view.image_id);
-    FilteredDepth filtered =
-        sources.empty() ? FilteredDepth{DepthMap(low.depth.Width(), low.depth.Height()),
-                                        DepthMap(low.depth.Width(), low.depth.Height())}
-                        : FilterGeometric(views.at(view.image_id), low, sources, options.filter);
-    const Camera& camera = model.CameraById(model.ImageById(view.image_id).camera_id);
-    MvsViewReport report;
-    report.name = view.name;
-    for (uint32_t id : view.sources) report.sources.push_back(model.ImageById(id).name);
-    report.min_depth = view.min_depth;
-    report.max_depth = view.max_depth;
-    WriteViewDepth(ws, camera, low, std::move(filtered), report);
-    summary.views.push_back(std::move(report));
+    summary.views.push_back(FilterAndWriteView(ws, model, plan.written[i], estimated, options));
   }
   progress.Update("filter", total, total);
   summary.geometric_seconds = Seconds(start);
+  fs::remove_all(ws.StereoEstimates());
   return summary;
 }
 

@@ -26,23 +26,34 @@ struct MvsOptions {
   // the geometric filter checks each depth against its sources' estimates.
   std::vector<std::string> only_views;
   int filter_sources = 2;
-  // Resolution of the estimate, as a share of each side (0.25..1): the photos are resampled to
-  // it, and the depth maps upsampled back (nearest, never blending depths across an edge) so
-  // every file keeps the photo's size. Half resolution is about 4x faster.
+  // The working resolution of the estimate: each photo is resampled to `image_scale` of each
+  // side (0.25..1), and further so that its long side is at most `max_image_size` pixels (0:
+  // no cap). The depth maps are upsampled back (nearest, never blending depths across an
+  // edge) so every file keeps the photo's size. The pixel-valued options above (windows,
+  // propagation offsets, reprojection tolerances, gap sizes) are in working pixels; a cap
+  // keeps that resolution, and so what they mean, alike for photos of any size.
   double image_scale = 1;
+  int max_image_size = 0;
+  // The share of each side a width x height photo is estimated at.
+  double ScaleFor(int width, int height) const;
   void Check() const;
 };
 
 // fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
 // balanced: 5 sources, 4x4 samples, 3 iterations, near and far neighbours;
-// best: 7 sources, 4 iterations.
+// best: 7 sources, 4 iterations. Long side capped at kMaxImageSize (docs/depth.md).
 MvsOptions MvsOptionsFor(Quality quality);
+
+// The working resolution's long-side cap at each quality (MvsOptions::max_image_size).
+int MaxImageSizeFor(Quality quality);
 
 struct MvsViewReport {
   std::string name;
   std::vector<std::string> sources;
   double min_depth = 0;
   double max_depth = 0;
+  int working_width = 0;  // The resolution the estimate ran at.
+  int working_height = 0;
   double photometric_share = 0;  // Share of pixels with a photometric depth.
   double geometric_share = 0;    // Share left after the geometric filter.
 };
@@ -56,10 +67,12 @@ struct MvsSummary {
 };
 
 // <ws>/depth/views.json and report.json's "depth" section: every field under its own name.
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MvsViewReport, name, sources, min_depth, max_depth,
-                                   photometric_share, geometric_share)
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE(MvsSummary, views, skipped, photometric_seconds,
-                                   geometric_seconds)
+// Fields missing from an older file read as their defaults.
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsViewReport, name, sources, min_depth, max_depth,
+                                                working_width, working_height, photometric_share,
+                                                geometric_share)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsSummary, views, skipped, photometric_seconds,
+                                                geometric_seconds)
 
 // Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
 MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,

@@ -1,13 +1,18 @@
 #include "pipeline/dense_stages.h"
 
+#include <cmath>
+#include <set>
+
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
 #include "core/hash.h"
+#include "core/sparse_model.h"
 #include "geometry/ply.h"
 #include "mesh/poisson.h"
 #include "mvs/fusion.h"
 #include "mvs/sgbm.h"
+#include "sfm/color_gains.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -15,18 +20,61 @@ namespace {
 
 // Bump when a stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-6";
-constexpr const char* kFusionVersion = "fusion-1";
+constexpr const char* kFusionVersion = "fusion-2";
 constexpr const char* kMeshVersion = "mesh-2";
+constexpr const char* kColorGainsVersion = "color-gains-1";
+
+// The working scale of every view, when one is below 1: what the results depend on, rather
+// than the knobs that chose it (a cap above the photos' size changes nothing, and keeps the
+// key of a workspace estimated before the cap existed).
+std::string ScaleKey(const Workspace& workspace, const MvsOptions& options) {
+  if (!DetectSparseFormat(workspace.Sparse())) {
+    return "scale " + std::to_string(options.image_scale) + " cap " + std::to_string(options.max_image_size);
+  }
+  std::set<double> scales;
+  const SparseModel model = ReadSparseModel(workspace.Sparse());
+  for (const Camera& camera : model.Cameras()) {
+    scales.insert(options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+  }
+  if (scales == std::set<double>{1.0}) return "";
+  std::string key = "scale";
+  for (const double scale : scales) key += " " + std::to_string(scale);
+  return key;
+}
+
+}  // namespace
 
 MvsOptions MvsOptionsOf(const DepthRequest& request) {
   MvsOptions options = MvsOptionsFor(request.quality);
   if (request.sources > 0) options.views.max_sources = request.sources;
-  options.image_scale = request.scale;
+  if (request.scale > 0) {
+    options.image_scale = request.scale;
+    options.max_image_size = 0;
+  }
+  if (request.max_size > 0) options.max_image_size = request.max_size;
   options.only_views = request.views;
   return options;
 }
 
-}  // namespace
+std::string DescribeDepthResolution(const DepthRequest& request, int width, int height) {
+  const MvsOptions options = MvsOptionsOf(request);
+  const double scale = options.ScaleFor(width, height);
+  const auto side = [scale](int pixels) { return std::to_string(std::max(1L, std::lround(pixels * scale))); };
+  std::string why;
+  if (request.max_size > 0) {
+    why = "--mvs-max-size " + std::to_string(request.max_size);
+  } else if (request.scale > 0) {
+    why = "--mvs-scale " + std::to_string(request.scale);
+  } else {
+    why = std::string(QualityName(request.quality)) + " caps the long side at " +
+          std::to_string(options.max_image_size) + " px (docs/depth.md: the best error for the time on real photos)";
+  }
+  char share[32];
+  std::snprintf(share, sizeof share, "%.3g", scale);
+  return "depth at " + side(width) + "x" + side(height) + " for " + std::to_string(width) + "x" +
+         std::to_string(height) + " photos (scale " + share + "): " + why +
+         (scale < 1 ? "; depth maps are written at the photo's size" : "");
+}
 
 Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
                  const DepthRequest& request, Progress& progress, MvsSummary* summary) {
@@ -36,7 +84,7 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
       .Add(static_cast<uint64_t>(request.quality))
       .Add(static_cast<uint64_t>(request.stereo))
       .Add(static_cast<uint64_t>(request.sources))
-      .Add(request.scale == 1 ? "" : "scale " + std::to_string(request.scale));
+      .Add(ScaleKey(workspace, MvsOptionsOf(request)));
   for (const std::string& view : request.views) hasher.Add(view);
   Stage stage;
   stage.name = "depth";
@@ -58,10 +106,32 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
   return stage;
 }
 
-Stage FusionStage(const Workspace& workspace, const std::string& depth_key, Progress& progress) {
+Stage ColorGainsStage(const Workspace& workspace, const std::string& undistort_key, std::string* note) {
+  Stage stage;
+  stage.name = "color_gains";
+  stage.key = Hasher().Add(undistort_key).Add(kColorGainsVersion).Hex();
+  stage.outputs = {workspace.ColorGainsFile()};
+  stage.run = [workspace, note] {
+    const ColorGainsEstimate estimate = EstimateColorGains(ReadSparseModel(workspace.Sparse()), workspace.Images());
+    WriteColorGains(workspace.ColorGainsFile(), estimate.gains);
+    if (note) *note = "color gains: " + estimate.note;
+  };
+  return stage;
+}
+
+std::string EnsureColorGains(const Workspace& workspace) {
+  if (fs::exists(workspace.ColorGainsFile())) return "";
+  StageGraph graph(workspace, false);
+  std::string note;
+  graph.Run(ColorGainsStage(workspace, UndistortedModelKey(workspace, graph), &note));
+  return note;
+}
+
+Stage FusionStage(const Workspace& workspace, const std::string& depth_key,
+                  const std::string& color_gains_key, Progress& progress) {
   Stage stage;
   stage.name = "fusion";
-  stage.key = Hasher().Add(depth_key).Add(kFusionVersion).Hex();
+  stage.key = Hasher().Add(depth_key).Add(color_gains_key).Add(kFusionVersion).Hex();
   stage.outputs = {workspace.Fused()};
   stage.run = [workspace, &progress] {
     WritePly(workspace.Fused(), FuseWorkspace(workspace.Root(), {}, progress));
@@ -69,12 +139,14 @@ Stage FusionStage(const Workspace& workspace, const std::string& depth_key, Prog
   return stage;
 }
 
-Stage MeshStage(const Workspace& workspace, const std::string& depth_key, Quality quality,
-                const Colmap& colmap, Progress& progress) {
+Stage MeshStage(const Workspace& workspace, const std::string& depth_key,
+                const std::string& color_gains_key, Quality quality, const Colmap& colmap,
+                Progress& progress) {
   Stage stage;
   stage.name = "mesh";
   stage.key = Hasher()
                   .Add(depth_key)
+                  .Add(color_gains_key)
                   .Add(kFusionVersion)
                   .Add(kMeshVersion)
                   .Add(static_cast<uint64_t>(quality))

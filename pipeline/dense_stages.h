@@ -19,20 +19,41 @@ struct DepthRequest {
   Quality quality = Quality::kBalanced;
   StereoMethod stereo = StereoMethod::kPatchMatch;
   int sources = 0;   // Source views per depth map; 0: as `quality` says.
-  double scale = 1;  // Resolution of the estimate (MvsOptions::image_scale).
+  // The working resolution (MvsOptions::image_scale, max_image_size). 0: as `quality`'s
+  // long-side cap says. A scale alone lifts the cap (scale 1 is the photo's full size).
+  double scale = 0;
+  int max_size = 0;
   // Only these views (image names); empty: every view, and depth/views.json is written.
   std::vector<std::string> views;
 };
+
+// The stereo's options for `request`.
+MvsOptions MvsOptionsOf(const DepthRequest& request);
+
+// What resolution the depth stage works at for photos of `width` x `height`, and why.
+std::string DescribeDepthResolution(const DepthRequest& request, int width, int height);
 
 // Depth maps for `request`, computed from the undistorted workspace that `undistort_key`
 // identifies. When it runs, the stage's summary goes to `*summary` (when not null).
 Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
                  const DepthRequest& request, Progress& progress, MvsSummary* summary = nullptr);
 
-Stage FusionStage(const Workspace& workspace, const std::string& depth_key, Progress& progress);
+// Each photo's exposure and white balance gain (sfm/color_gains.h), from the undistorted model
+// and photos; its note goes to `*note` when it runs.
+Stage ColorGainsStage(const Workspace& workspace, const std::string& undistort_key, std::string* note = nullptr);
 
-Stage MeshStage(const Workspace& workspace, const std::string& depth_key, Quality quality,
-                const Colmap& colmap, Progress& progress);
+// Runs the color gains stage through the workspace's graph when the workspace (made before
+// gains were estimated) lacks them; returns what it did, or "" when they were there.
+std::string EnsureColorGains(const Workspace& workspace);
+
+// Fusion and mesh take their colors from the photos, corrected by the gains that
+// `color_gains_key` identifies.
+Stage FusionStage(const Workspace& workspace, const std::string& depth_key,
+                  const std::string& color_gains_key, Progress& progress);
+
+Stage MeshStage(const Workspace& workspace, const std::string& depth_key,
+                const std::string& color_gains_key, Quality quality, const Colmap& colmap,
+                Progress& progress);
 
 // The key that identifies a workspace's undistorted model: the one its undistort stage
 // completed with, or, for a workspace not made by reconstruct, a hash of its model files.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <optional>
+#include <set>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -86,6 +88,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
             {"problems", plausibility.problems}}},
           {"depth", summary.depth ? nlohmann::json(*summary.depth) : nlohmann::json()},
           {"mesh", summary.mesh ? nlohmann::json(*summary.mesh) : nlohmann::json()},
+          {"depth_resolution", summary.depth_resolution},
           {"notes", summary.notes},
           {"warnings", summary.warnings}};
 }
@@ -157,22 +160,48 @@ SparseModel CheckRawModel(const SfmContext& sfm, ReconstructSummary& summary) {
   return raw_model;
 }
 
+DepthRequest DepthRequestOf(const ReconstructOptions& options) {
+  DepthRequest request;
+  request.quality = options.quality;
+  request.stereo = options.stereo;
+  request.sources = options.mvs_sources;
+  request.scale = options.mvs_scale;
+  request.max_size = options.mvs_max_size;
+  return request;
+}
+
+std::vector<std::string> DescribeDepthResolutions(const DepthRequest& request,
+                                                  const std::set<std::pair<int, int>>& sizes) {
+  std::vector<std::string> descriptions;
+  for (const auto& [width, height] : sizes) descriptions.push_back(DescribeDepthResolution(request, width, height));
+  return descriptions;
+}
+
 // Depth, fusion and (unless --no-mesh) the textured mesh, after undistortion.
 void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, StageGraph& graph,
                     ReconstructSummary& summary) {
   const ReconstructOptions& options = sfm.options;
   const Workspace& paths = sfm.workspace;
-  const DepthRequest depth_request{options.quality, options.stereo, options.mvs_sources,
-                                   options.mvs_scale, {}};
+  const DepthRequest depth_request = DepthRequestOf(options);
+  std::set<std::pair<int, int>> sizes;
+  const SparseModel model = ReadSparseModel(paths.Sparse());
+  for (const Camera& camera : model.Cameras()) {
+    sizes.emplace(static_cast<int>(camera.width), static_cast<int>(camera.height));
+  }
+  summary.depth_resolution = DescribeDepthResolutions(depth_request, sizes);
   const Stage depth = DepthStage(paths, undistort_key, depth_request, sfm.progress);
   graph.Run(depth);
   summary.depth = nlohmann::json::parse(ReadFileBytes(paths.DepthViews())).get<MvsSummary>();
-  graph.Run(FusionStage(paths, depth.key, sfm.progress));
+  std::string gains_note;
+  const Stage color_gains = ColorGainsStage(paths, undistort_key, &gains_note);
+  graph.Run(color_gains);
+  if (!gains_note.empty()) summary.notes.push_back(gains_note);
+  graph.Run(FusionStage(paths, depth.key, color_gains.key, sfm.progress));
   if (!options.build_mesh) {
     summary.notes.push_back("mesh: not built (--no-mesh)");
     return;
   }
-  graph.Run(MeshStage(paths, depth.key, options.quality, sfm.colmap, sfm.progress));
+  graph.Run(MeshStage(paths, depth.key, color_gains.key, options.quality, sfm.colmap, sfm.progress));
   summary.mesh = nlohmann::json::parse(ReadFileBytes(paths.MeshSummary())).get<MeshSummary>();
 }
 
@@ -201,7 +230,13 @@ void ReconstructOptions::Check() const {
   RequireOption(max_refined_principal_point_offset > 0, "ReconstructOptions.max_refined_principal_point_offset",
                 max_refined_principal_point_offset, "> 0");
   RequireOption(mvs_sources >= 0, "ReconstructOptions.mvs_sources", mvs_sources, ">= 0");
-  RequireOption(mvs_scale >= 0.25 && mvs_scale <= 1, "ReconstructOptions.mvs_scale", mvs_scale, "[0.25, 1]");
+  RequireOption(mvs_scale == 0 || (mvs_scale >= 0.25 && mvs_scale <= 1), "ReconstructOptions.mvs_scale",
+                mvs_scale, "0 (as quality says) or [0.25, 1]");
+  RequireOption(mvs_max_size == 0 || mvs_max_size >= 64, "ReconstructOptions.mvs_max_size", mvs_max_size,
+                "0 (as quality says) or >= 64");
+  if (mvs_scale > 0 && mvs_max_size > 0) {
+    throw std::invalid_argument("mvs_scale and mvs_max_size exclude each other");
+  }
   plausibility.Check();
 }
 
@@ -240,6 +275,11 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   graph.Run(mapper);
   if (options.dry_run) {
     graph.Run(UndistortStage(sfm, mapper.key, nullptr));
+    if (options.estimate_depth) {
+      std::set<std::pair<int, int>> sizes;
+      for (const Photo& photo : photos.photos) sizes.emplace(photo.width, photo.height);
+      summary.depth_resolution = DescribeDepthResolutions(DepthRequestOf(options), sizes);
+    }
     summary.stages = graph.Records();
     return summary;
   }

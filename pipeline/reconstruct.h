@@ -65,8 +65,11 @@ struct ReconstructOptions {
   StereoMethod stereo = StereoMethod::kPatchMatch;
   // Source views per depth map; 0 = as `quality` says.
   int mvs_sources = 0;
-  // Resolution of the depth estimate as a share of each photo side (MvsOptions::image_scale).
-  double mvs_scale = 1;
+  // Resolution of the depth estimate: 0 for `quality`'s long-side cap (MaxImageSizeFor), or a
+  // share of each photo side (MvsOptions::image_scale, no cap), or a long-side cap in pixels.
+  // At most one of the two is set.
+  double mvs_scale = 0;
+  int mvs_max_size = 0;
   // After depth: Poisson mesh, trimmed and textured (pipeline/mesh.h).
   bool build_mesh = true;
   void Check() const;  // Throws std::invalid_argument naming the field.
@@ -89,6 +92,8 @@ struct ReconstructSummary {
   // to <ws>/depth/views.json); absent when depth was not estimated.
   std::optional<MvsSummary> depth;
   std::optional<MeshSummary> mesh;  // Absent when no mesh was built.
+  // The depth stage's working resolution for each photo size, and why.
+  std::vector<std::string> depth_resolution;
   std::vector<std::string> notes;  // Decisions worth knowing (e.g. a refinement kept or not).
   std::vector<std::string> warnings;
 };

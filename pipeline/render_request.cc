@@ -69,6 +69,17 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
                                             " views: those these cameras use and had none"));
 }
 
+// The workspace's color gains, estimated through its graph when a workspace made before they
+// existed lacks them.
+RequestStage ColorGainsStep(const fs::path& input, bool scene_folder, bool wanted, Progress& progress) {
+  if (scene_folder) return Skipped("color_gains", "a scene folder: its photos are used as they are");
+  if (!wanted) return Skipped("color_gains", "--no-color-gains: photos blended as they are");
+  const Workspace workspace(input);
+  const std::string note = EnsureColorGains(workspace);
+  if (note.empty()) return Skipped("color_gains", "already estimated: " + workspace.ColorGainsFile().string());
+  return Ran("color_gains", note);
+}
+
 RequestStage DepthHolesStage(bool scene_folder, const SourceLibrary& library,
                              const WorkspaceDepthPreparation& depth_holes) {
   if (scene_folder) return Skipped("depth_holes", "ground-truth depth has no holes");
@@ -104,13 +115,16 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
                             const NovelViewSettings& settings, const fs::path& out,
                             Progress& progress, const RenderedView& on_view) {
   RenderSummary summary;
-  SourceLibrary library(SourcePathsFor(input));
+  const SceneFolder scene{input};
+  const bool scene_folder = fs::is_directory(scene.GroundTruth());
+  ViewSetPaths source_paths = SourcePathsFor(input);
+  summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains, progress));
+  if (!settings.color_gains) source_paths.color_gains.clear();
+  SourceLibrary library(source_paths);
   const std::vector<NamedCamera> targets =
       cameras.path ? CamerasAlongPath(*cameras.path, library.Cameras(), library.Names())
                    : CamerasFromModel(cameras.model);
   summary.source_views = library.Cameras().size();
-  const SceneFolder scene{input};
-  const bool scene_folder = fs::is_directory(scene.GroundTruth());
   if (scene_folder) {
     summary.stages.push_back(Skipped("depth", "a scene folder: its ground-truth depth maps are used"));
   } else {

@@ -103,6 +103,7 @@ ViewSetPaths SourcePathsFor(const fs::path& root) {
     paths.images = workspace.Images();
     paths.sparse = workspace.Sparse();
     paths.depth = workspace.DepthDir();
+    paths.color_gains = workspace.ColorGainsFile();
     return paths;
   }
   const SceneFolder scene{root};
@@ -173,6 +174,7 @@ std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
 
 SourceLibrary::SourceLibrary(ViewSetPaths paths) : paths_(std::move(paths)) {
   cameras_ = ReadPosedCameras(paths_, &names_);
+  if (!paths_.color_gains.empty() && fs::exists(paths_.color_gains)) gains_ = ReadColorGains(paths_.color_gains);
   loaded_.resize(cameras_.size());
 }
 
@@ -196,6 +198,12 @@ const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp)
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     PrepareSource(view.get(), warp);
+    if (gains_.Of(name) != RgbGain{1, 1, 1}) {
+      const std::vector<uint8_t> background = view->background;
+      ApplyGain(gains_.Of(name), view->color);
+      PrepareSource(view.get(), warp);
+      view->background = background;
+    }
     slot = std::move(view);
   }
   return *slot;
@@ -267,6 +275,27 @@ std::vector<Eigen::Vector3d> UnseenPoints(const RenderResult& result, const Pose
   return points;
 }
 
+namespace {
+
+// Sources corrected by their color gains blend without exposure steps, at the exposure common
+// to the set; a photo taken at the target would rather have the exposure of the cameras
+// nearby (auto exposure follows what is in view): the inverse of the geometric mean of the
+// selected sources' gains.
+RgbGain ExposureOfSources(const SourceLibrary& library, const std::vector<int>& selected) {
+  std::array<double, 3> log_sum{0, 0, 0};
+  for (const int index : selected) {
+    const RgbGain gain = library.Gain(index);
+    for (size_t c = 0; c < 3; ++c) log_sum[c] += std::log(static_cast<double>(gain[c]));
+  }
+  RgbGain exposure;
+  for (size_t c = 0; c < 3; ++c) {
+    exposure[c] = static_cast<float>(std::exp(-log_sum[c] / static_cast<double>(std::max<size_t>(1, selected.size()))));
+  }
+  return exposure;
+}
+
+}  // namespace
+
 void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                      const SourceSelectionOptions& selection, Renderer& renderer, NovelView* view) {
   using Clock = std::chrono::steady_clock;
@@ -280,6 +309,7 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
   std::vector<const SourceView*> sources;
   const ForwardWarpOptions& warp = renderer.Options().warp;
   for (int index : chosen) sources.push_back(&library.Load(index, warp));
+  const std::vector<int> selected = chosen;
   Clock::duration spent = select_end - select_start;
   // More sources, one at a time, while unseen pixels remain and some source sees them.
   const int hole_sources =
@@ -309,6 +339,7 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     unseen = unseen_after;
   }
   for (int index : chosen) view->sources.push_back(library.Names()[static_cast<size_t>(index)]);
+  ApplyGain(ExposureOfSources(library, {selected.front()}), view->result.color);
   // Selection and rendering; reading files is left out (the first targets pay for all).
   view->ms = std::chrono::duration<double, std::milli>(spent).count();
 }

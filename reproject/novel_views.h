@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "core/color_gains.h"
 #include "core/scene_folder.h"
 #include "reproject/render.h"
 #include "reproject/source_selection.h"
@@ -47,7 +48,8 @@ std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names);
 
-// Source cameras up front; each view's photo and depth read from disk on first use only.
+// Source cameras up front; each view's photo and depth read from disk on first use only, the
+// photo corrected by its color gain when the paths name a gains file.
 class SourceLibrary {
  public:
   explicit SourceLibrary(ViewSetPaths paths);
@@ -58,6 +60,8 @@ class SourceLibrary {
   // naming the file for a missing or corrupt photo or depth map.
   const SourceView& Load(int index, const ForwardWarpOptions& warp);
   int LoadedCount() const;
+  // The color gain the view's photo is corrected by as it loads (1 without a gains file).
+  RgbGain Gain(int index) const { return gains_.Of(names_.at(static_cast<size_t>(index))); }
   // Runs on each view as it is loaded, before it is warped, to prepare its depth map (for a
   // workspace's estimated depth: specks out, holes from the mesh; see reproject/workspace_depth.h);
   // returns how many pixels it gave depth. Call before any Load.
@@ -75,6 +79,7 @@ class SourceLibrary {
   std::vector<PosedCamera> cameras_;
   std::vector<std::string> names_;
   std::vector<std::unique_ptr<SourceView>> loaded_;
+  ColorGains gains_;  // From paths_.color_gains: each photo's color as read, times its gain.
   DepthPreparation preparation_;
   long prepared_pixels_ = 0;
   long loaded_pixels_ = 0;

@@ -27,6 +27,9 @@ struct NovelViewSettings {
   // --edge-erosion: a workspace's depth pixels this close to a farther neighbour, on the near
   // side, are dropped (ErodeDepthEdges); 0 keeps them.
   int edge_erosion_px = 1;
+  // --no-color-gains clears it: the photos are blended as they are, without the workspace's
+  // per-photo exposure and white balance correction (core/color_gains.h).
+  bool color_gains = true;
   // Applies `warp` to `render`; call before using the settings.
   void Resolve();
 };
