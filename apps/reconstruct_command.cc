@@ -21,7 +21,7 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
     } else if (dry_run) {
       std::printf("  %-12s will run: %s\n", stage.name.c_str(), stage.reason.c_str());
     } else {
-      std::printf("  %-12s %7.1f s\n", stage.name.c_str(), stage.seconds);
+      std::printf("  %-12s %7.1f s %7.0f MB\n", stage.name.c_str(), stage.seconds, stage.peak_rss_mb);
     }
   }
   if (!dry_run) {

@@ -162,7 +162,6 @@ void Bench::Depth() {
       {"balanced", "patchmatch", "quality=balanced (1024 px)", {"--quality", "balanced"}},
       {"balanced_1536", "patchmatch", "quality=balanced 1536 px", {"--mvs-max-size", "1536"}},
       {"balanced_full", "patchmatch", "quality=balanced full size", {"--mvs-scale", "1"}},
-      {"best", "patchmatch", "quality=best (1600 px)", {"--quality", "best"}},
       {"sgbm", "sgbm", "OpenCV StereoSGBM, rectified pairs", {"--stereo", "sgbm"}, true}};
   const std::vector<Setting> synthetic_settings = {
       {"fast", "patchmatch", "quality=fast sources=3", {"--quality", "fast"}},

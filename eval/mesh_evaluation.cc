@@ -1,5 +1,6 @@
 #include "eval/mesh_evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/error.h"
@@ -30,7 +31,7 @@ Image RenderTexturedMesh(const TriangleMesh& mesh, const MeshRaycaster& raycaste
   return render;
 }
 
-TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model,
+TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model, const ColorGains& gains,
                                     const fs::path& images_dir, const fs::path& render_dir) {
   TexturedMeshScore score;
   if (!render_dir.empty()) fs::create_directories(render_dir);
@@ -44,7 +45,13 @@ TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel&
                           ": not an RGB image of its camera's size");
     }
     std::vector<uint8_t> covered;
-    const Image render = RenderTexturedMesh(mesh, raycaster, camera, image.cam_from_world, covered);
+    Image render = RenderTexturedMesh(mesh, raycaster, camera, image.cam_from_world, covered);
+    if (const RgbGain gain = gains.Of(image.name); gain != RgbGain{1, 1, 1}) {
+      Image linear = SrgbToLinear(render);
+      ApplyGain({1 / gain[0], 1 / gain[1], 1 / gain[2]}, linear);
+      render = LinearToSrgb(linear);
+      for (float& value : render.Pixels()) value = std::clamp(value, 0.0f, 1.0f);
+    }
     double squared_error = 0;
     size_t pixels = 0;
     for (int y = 0; y < render.Height(); ++y) {

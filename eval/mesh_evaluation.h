@@ -3,6 +3,7 @@
 // workspace camera and compared with that camera's photo on the pixels the mesh covers.
 #include <filesystem>
 
+#include "core/color_gains.h"
 #include "core/sparse_model.h"
 #include "geometry/raycaster.h"
 #include "geometry/obj.h"
@@ -16,9 +17,11 @@ struct TexturedMeshScore {
 };
 
 // Renders `mesh` from every image of `model` (distortion-free cameras) and compares with
-// `images_dir`/<name>. With a non-empty `render_dir`, writes each render there as
-// <stem>.png (uncovered pixels black) to look at.
-TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model,
+// `images_dir`/<name>. An atlas made at the photos' common exposure (core/color_gains.h) is
+// compared at each photo's own: its render divided by the photo's gain in `gains`. With a
+// non-empty `render_dir`, writes each render there as <stem>.png (uncovered pixels black) to
+// look at.
+TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const SparseModel& model, const ColorGains& gains,
                                     const std::filesystem::path& images_dir,
                                     const std::filesystem::path& render_dir);
 

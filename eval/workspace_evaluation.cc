@@ -47,7 +47,8 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
     result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
   }
   result.render_dir = workspace.MeshRenders();
-  result.texture = ScoreTexturedMesh(mesh, estimate, workspace.Images(), result.render_dir);
+  result.texture = ScoreTexturedMesh(mesh, estimate, ReadWorkspaceColorGains(workspace.Root()), workspace.Images(),
+                                     result.render_dir);
   return result;
 }
 

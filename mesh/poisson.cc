@@ -93,6 +93,7 @@ TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius)
   return trimmed;
 }
 
+// The cameras, each photo read (and corrected by its color gain) only when the texture needs it.
 std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
   const Workspace ws(workspace);
   const SparseModel model = ReadSparseModel(ws.Sparse());
@@ -102,8 +103,11 @@ std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
     TextureView view;
     view.camera = model.CameraById(image.camera_id);
     view.cam_from_world = image.cam_from_world;
-    view.color = SrgbToLinear(ReadImage(ws.Image(image.name)));
-    ApplyGain(gains.Of(image.name), view.color);
+    view.load_color = [path = ws.Image(image.name), gain = gains.Of(image.name)] {
+      Image color = SrgbToLinear(ReadImage(path));
+      ApplyGain(gain, color);
+      return color;
+    };
     views.push_back(std::move(view));
   }
   return views;

@@ -130,23 +130,35 @@ double MedianEdgePixels(const std::vector<Eigen::Vector3f>& vertices,
   return static_cast<double>(edges[edges.size() / 2]);
 }
 
-// Linear color of a surface point from the triangle's ranked photos.
-Eigen::Vector3f BlendedColor(const Eigen::Vector3f& point, const Candidates& candidates,
-                              const std::vector<TextureView>& views, double exponent) {
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float total = 0;
-  for (const Candidate& candidate : candidates) {
-    if (candidate.view < 0) break;
-    const TextureView& view = views[static_cast<size_t>(candidate.view)];
-    Eigen::Vector2f pixel;
-    float depth = 0;
-    if (!ProjectPinhole(view, point, pixel, depth) || !Inside(view, pixel, -kBorderPixels)) continue;
-    const float weight = static_cast<float>(
-        std::pow(static_cast<double>(candidate.score / candidates[0].score), exponent));
-    sum += weight * SampleBilinear(view.color, pixel);
-    total += weight;
+// The views' photos, one at a time: each photo's weighted samples added to the texels of the
+// triangles that ranked it, then the texels divided by their weights.
+class TexelAccumulator {
+ public:
+  explicit TexelAccumulator(size_t texels) : sums_(4 * texels, 0.0f) {}
+
+  void Add(size_t texel, const Eigen::Vector3f& color, float weight) {
+    float* sum = &sums_[4 * texel];
+    for (int c = 0; c < 3; ++c) sum[c] += weight * color[c];
+    sum[3] += weight;
   }
-  return total > 0 ? Eigen::Vector3f(sum / total) : Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
+  // Linear color; mid-grey where no photo contributed.
+  Eigen::Vector3f Color(size_t texel) const {
+    const float* sum = &sums_[4 * texel];
+    if (!(sum[3] > 0)) return Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
+    return Eigen::Vector3f(sum[0], sum[1], sum[2]) / sum[3];
+  }
+
+ private:
+  std::vector<float> sums_;
+};
+
+Image ColorOf(const TextureView& view) {
+  Image color = view.color.Pixels().empty() && view.load_color ? view.load_color() : view.color;
+  if (static_cast<uint64_t>(color.Width()) != view.camera.width ||
+      static_cast<uint64_t>(color.Height()) != view.camera.height || color.Channels() < 3) {
+    throw std::invalid_argument("texture: a view's photo is not an RGB image of its camera's size");
+  }
+  return color;
 }
 
 }  // namespace
@@ -169,10 +181,7 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          TextureSummary& summary) {
   options.Check();
   for (const TextureView& view : views) {
-    if (view.camera.HasDistortion() || static_cast<uint64_t>(view.color.Width()) != view.camera.width ||
-        static_cast<uint64_t>(view.color.Height()) != view.camera.height || view.color.Channels() < 3) {
-      throw std::invalid_argument("texture: views must be distortion-free with RGB images of the camera's size");
-    }
+    if (view.camera.HasDistortion()) throw std::invalid_argument("texture: views must be distortion-free");
   }
   const std::vector<Candidates> ranked = RankViews(vertices, triangles, views, options);
 
@@ -196,38 +205,77 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
   mesh.corner_uvs.resize(3 * triangles.size());
   const float width = static_cast<float>(mesh.atlas.Width());
   const float height = static_cast<float>(mesh.atlas.Height());
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()),
-                    [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t t = range.begin(); t < range.end(); ++t) {
-      const int cell_x = static_cast<int>(t) % columns * cell;
-      const int cell_y = static_cast<int>(t) / columns * cell;
-      // Corner 0 at the inner lower-left, 1 along the row, 2 along the column (image rows
-      // run down; the OBJ v axis runs up).
-      const Eigen::Vector2f origin(static_cast<float>(cell_x + 1), static_cast<float>(cell_y + 1));
-      const float leg = static_cast<float>(texels);
-      const std::array<Eigen::Vector2f, 3> corners = {
-          origin, origin + Eigen::Vector2f(leg, 0), origin + Eigen::Vector2f(0, leg)};
-      for (int c = 0; c < 3; ++c) {
-        mesh.corner_uvs[3 * t + static_cast<size_t>(c)] =
-            Eigen::Vector2f(corners[static_cast<size_t>(c)].x() / width, 1.0f - corners[static_cast<size_t>(c)].y() / height);
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector2f origin(static_cast<float>(static_cast<int>(t) % columns * cell + 1),
+                                 static_cast<float>(static_cast<int>(t) / columns * cell + 1));
+    // Corner 0 at the inner lower-left, 1 along the row, 2 along the column (image rows run
+    // down; the OBJ v axis runs up).
+    const std::array<Eigen::Vector2f, 3> corners = {origin, origin + Eigen::Vector2f(static_cast<float>(texels), 0),
+                                                    origin + Eigen::Vector2f(0, static_cast<float>(texels))};
+    for (size_t c = 0; c < 3; ++c) {
+      mesh.corner_uvs[3 * t + c] = Eigen::Vector2f(corners[c].x() / width, 1.0f - corners[c].y() / height);
+    }
+  }
+  // The surface point each texel of triangle t shows: texels outside the triangle take its
+  // nearest point.
+  const auto texel_point = [&](size_t t, int i, int j) {
+    const Eigen::Vector3i& tri = triangles[t];
+    const Eigen::Vector3f& v0 = vertices[static_cast<size_t>(tri[0])];
+    const float leg = static_cast<float>(texels);
+    float a = std::max(0.0f, (static_cast<float>(i) - 0.5f) / leg);
+    float b = std::max(0.0f, (static_cast<float>(j) - 0.5f) / leg);
+    if (a + b > 1) {
+      const float sum = a + b;
+      a /= sum;
+      b /= sum;
+    }
+    return Eigen::Vector3f(v0 + a * (vertices[static_cast<size_t>(tri[1])] - v0) +
+                           b * (vertices[static_cast<size_t>(tri[2])] - v0));
+  };
+  const auto texel_index = [&](size_t t, int i, int j) {
+    const int x = static_cast<int>(t) % columns * cell + i, y = static_cast<int>(t) / columns * cell + j;
+    return static_cast<size_t>(y) * static_cast<size_t>(mesh.atlas.Width()) + static_cast<size_t>(x);
+  };
+  // Which triangles rank each photo, and with what weight (score / best score)^exponent.
+  std::vector<std::vector<std::pair<size_t, float>>> uses(views.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    for (const Candidate& candidate : ranked[t]) {
+      if (candidate.view < 0) break;
+      const double ratio = static_cast<double>(candidate.score / ranked[t][0].score);
+      uses[static_cast<size_t>(candidate.view)].emplace_back(
+          t, static_cast<float>(std::pow(ratio, options.blend_exponent)));
+    }
+  }
+  TexelAccumulator texels_sum(static_cast<size_t>(mesh.atlas.Width()) * static_cast<size_t>(mesh.atlas.Height()));
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (uses[v].empty()) continue;
+    const TextureView& view = views[v];
+    const Image color = ColorOf(view);
+    // Triangles own disjoint cells: in parallel without contention.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, uses[v].size()), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t u = range.begin(); u < range.end(); ++u) {
+        const auto [t, weight] = uses[v][u];
+        for (int j = 0; j < cell; ++j) {
+          for (int i = 0; i < cell; ++i) {
+            Eigen::Vector2f pixel;
+            float depth = 0;
+            if (!ProjectPinhole(view, texel_point(t, i, j), pixel, depth) || !Inside(view, pixel, -kBorderPixels)) {
+              continue;
+            }
+            texels_sum.Add(texel_index(t, i, j), SampleBilinear(color, pixel), weight);
+          }
+        }
       }
-      const Eigen::Vector3i& tri = triangles[t];
-      const Eigen::Vector3f& v0 = vertices[static_cast<size_t>(tri[0])];
-      const Eigen::Vector3f e1 = vertices[static_cast<size_t>(tri[1])] - v0;
-      const Eigen::Vector3f e2 = vertices[static_cast<size_t>(tri[2])] - v0;
+    });
+  }
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t t = range.begin(); t < range.end(); ++t) {
+      const int cell_x = static_cast<int>(t) % columns * cell, cell_y = static_cast<int>(t) / columns * cell;
       for (int j = 0; j < cell; ++j) {
         for (int i = 0; i < cell; ++i) {
-          float a = std::max(0.0f, (static_cast<float>(i) - 0.5f) / leg);
-          float b = std::max(0.0f, (static_cast<float>(j) - 0.5f) / leg);
-          if (a + b > 1) {
-            const float sum = a + b;
-            a /= sum;
-            b /= sum;
-          }
-          const Eigen::Vector3f color =
-              BlendedColor(v0 + a * e1 + b * e2, ranked[t], views, options.blend_exponent);
+          const Eigen::Vector3f linear = texels_sum.Color(texel_index(t, i, j));
           for (int c = 0; c < 3; ++c) {
-            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(color[c]), 0.0f, 1.0f);
+            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(linear[c]), 0.0f, 1.0f);
           }
         }
       }

@@ -3,6 +3,7 @@
 // from the photo that sees it best (most head-on and most pixels per unit area) without
 // occlusion (Embree visibility). Photos nearly as good are blended in with a steeply falling
 // weight, so the seam between triangles that chose different photos fades instead of jumping.
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,7 +18,11 @@ namespace parallax {
 struct TextureView {
   Camera camera;  // Distortion-free (the undistorted workspace).
   Rigid3d cam_from_world;
-  Image color;   // Linear RGB, camera.width x camera.height.
+  // Linear RGB, camera.width x camera.height; or, when empty, what `load_color` returns.
+  // TextureMesh reads the photos one at a time, so that its memory is one photo and the
+  // atlas, whatever their number.
+  Image color;
+  std::function<Image()> load_color;
 };
 
 struct TextureOptions {
@@ -40,7 +45,7 @@ struct TextureSummary {
   size_t untextured_triangles = 0;  // No photo sees them: mid-grey.
 };
 
-// Throws std::invalid_argument for invalid options or views.
+// Throws std::invalid_argument for invalid options or views (or what load_color throws).
 TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles,
                          const std::vector<TextureView>& views, const TextureOptions& options,

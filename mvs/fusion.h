@@ -22,7 +22,7 @@ struct FusionOptions {
   double max_normal_angle_deg = 20;
   // Each view is merged with the views that share the most sparse points with it, at most
   // this many; only they are in memory with it, so memory does not grow with the photo count.
-  int max_neighbours = 16;
+  int max_neighbours = 8;
   void Check() const;
 };
 

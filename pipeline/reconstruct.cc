@@ -56,8 +56,8 @@ void FillModelStatistics(const SparseModel& model, const PhotoSet& photos,
 nlohmann::json ReportJson(const ReconstructSummary& summary) {
   nlohmann::json stages = nlohmann::json::array(), timings = nlohmann::json::object();
   for (const StageRecord& stage : summary.stages) {
-    stages.push_back({{"name", stage.name}, {"skipped", stage.skipped},
-                      {"reason", stage.reason}, {"seconds", stage.seconds}});
+    stages.push_back({{"name", stage.name}, {"skipped", stage.skipped}, {"reason", stage.reason},
+                      {"seconds", stage.seconds}, {"peak_rss_mb", stage.peak_rss_mb}});
     timings[stage.name] = stage.seconds;
   }
   nlohmann::json skipped_files = nlohmann::json::array();

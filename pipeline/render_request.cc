@@ -71,7 +71,7 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
 
 // The workspace's color gains, estimated through its graph when a workspace made before they
 // existed lacks them.
-RequestStage ColorGainsStep(const fs::path& input, bool scene_folder, bool wanted, Progress& progress) {
+RequestStage ColorGainsStep(const fs::path& input, bool scene_folder, bool wanted) {
   if (scene_folder) return Skipped("color_gains", "a scene folder: its photos are used as they are");
   if (!wanted) return Skipped("color_gains", "--no-color-gains: photos blended as they are");
   const Workspace workspace(input);
@@ -118,7 +118,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   const SceneFolder scene{input};
   const bool scene_folder = fs::is_directory(scene.GroundTruth());
   ViewSetPaths source_paths = SourcePathsFor(input);
-  summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains, progress));
+  summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains));
   if (!settings.color_gains) source_paths.color_gains.clear();
   SourceLibrary library(source_paths);
   const std::vector<NamedCamera> targets =

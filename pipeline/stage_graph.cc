@@ -1,5 +1,7 @@
 #include "pipeline/stage_graph.h"
 
+#include "core/memory.h"
+
 #include <algorithm>
 #include <chrono>
 
@@ -17,7 +19,7 @@ StageGraph::StageGraph(const Workspace& workspace, bool dry_run)
     : cache_(workspace.Stages()), dry_run_(dry_run) {}
 
 void StageGraph::Run(const Stage& stage) {
-  StageRecord record{stage.name, false, "", 0};
+  StageRecord record{stage.name, false, "", 0, 0};
   const bool outputs_exist = AllExist(stage.outputs);
   if (cache_.IsDone(stage.name, stage.key) && outputs_exist) {
     record.skipped = true;
@@ -28,9 +30,11 @@ void StageGraph::Run(const Stage& stage) {
                     : outputs_exist           ? "inputs or options changed"
                                               : "not run yet";
   } else {
+    ResetPeakResidentMemory();
     const auto start = std::chrono::steady_clock::now();
     stage.run();
     record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.peak_rss_mb = PeakResidentMemoryMb();
     cache_.MarkDone(stage.name, stage.key);
     record.skipped = !stage.not_needed.empty();
     record.reason = stage.not_needed;

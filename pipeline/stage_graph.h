@@ -33,6 +33,9 @@ struct StageRecord {
   bool skipped = false;
   std::string reason;
   double seconds = 0;
+  // Peak resident memory of this process while the stage ran (colmap's own processes, which
+  // some stages run, are not counted); 0 when it did not run.
+  double peak_rss_mb = 0;
 };
 
 class StageGraph {

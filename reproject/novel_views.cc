@@ -339,7 +339,7 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     unseen = unseen_after;
   }
   for (int index : chosen) view->sources.push_back(library.Names()[static_cast<size_t>(index)]);
-  ApplyGain(ExposureOfSources(library, {selected.front()}), view->result.color);
+  ApplyGain(ExposureOfSources(library, selected), view->result.color);
   // Selection and rendering; reading files is left out (the first targets pay for all).
   view->ms = std::chrono::duration<double, std::milli>(spent).count();
 }

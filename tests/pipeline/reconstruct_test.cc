@@ -23,6 +23,7 @@
 #include "tests/cli_runner.h"
 #include "eval/depth_evaluation.h"
 #include "eval/evaluate.h"
+#include "eval/workspace_evaluation.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -123,6 +124,27 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   const Rigid3d& original = model.FindImageByName("0003.png")->cam_from_world;
   EXPECT_LT(RotationAngleDeg(twin.rotation, original.rotation), 0.05);
   EXPECT_LT((CameraCenter(twin) - CameraCenter(original)).norm(), 0.002 * evaluation.extent);
+
+  // Real photos come with cameras and held-out photos but no depth: everything else is scored,
+  // and what is not is said.
+  const TempDir real_dir;
+  for (const char* part : {"images", "gt/sparse", "novel/images", "novel/sparse"}) {
+    std::filesystem::create_directories(real_dir.Path() / part);
+    std::filesystem::copy(kSmall / part, real_dir.Path() / part, std::filesystem::copy_options::recursive);
+  }
+  const WorkspaceEvaluation real = EvaluateWorkspace(Workspace(workspace.Path()), SceneFolder{real_dir.Path()}, {},
+                                                     progress);
+  EXPECT_FALSE(real.depth.has_value());
+  EXPECT_FALSE(real.fused.has_value());
+  ASSERT_TRUE(real.mesh.has_value());
+  EXPECT_FALSE(real.mesh->accuracy.has_value());
+  EXPECT_GT(real.mesh->texture.psnr_mean, 20);
+  ASSERT_EQ(real.not_scored.size(), 1u);
+  EXPECT_NE(real.not_scored[0].find("no ground-truth depth"), std::string::npos) << real.not_scored[0];
+  ASSERT_TRUE(real.novel.has_value());
+  EXPECT_EQ(real.novel->result.views, 4);
+  EXPECT_GT(real.novel->result.psnr_mean, 20);
+  EXPECT_GE(real.novel->result.psnr_exposure_matched_mean, real.novel->result.psnr_mean - 0.5);
 }
 
 TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
@@ -187,7 +209,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_LT(vertices.median_relative_distance, 0.005);
   EXPECT_GT(vertices.within_1pct, 0.8);
   const TexturedMeshScore texture =
-      ScoreTexturedMesh(mesh, model, workspace.Path() / "images", {});
+      ScoreTexturedMesh(mesh, model, ReadWorkspaceColorGains(workspace.Path()), workspace.Path() / "images", {});
   EXPECT_EQ(texture.views, 12);
   EXPECT_GE(texture.psnr_mean, 25);
   EXPECT_GT(texture.coverage_mean, 0.5);
