@@ -131,25 +131,34 @@ double MedianEdgePixels(const std::vector<Eigen::Vector3f>& vertices,
 }
 
 // The views' photos, one at a time: each photo's weighted samples added to the texels of the
-// triangles that ranked it, then the texels divided by their weights.
+// triangles that ranked it (in the atlas itself), then the texels divided by their weights.
 class TexelAccumulator {
  public:
-  explicit TexelAccumulator(size_t texels) : sums_(4 * texels, 0.0f) {}
+  explicit TexelAccumulator(Image& atlas)
+      : atlas_(atlas), weights_(static_cast<size_t>(atlas.Width()) * static_cast<size_t>(atlas.Height()), 0.0f) {}
 
   void Add(size_t texel, const Eigen::Vector3f& color, float weight) {
-    float* sum = &sums_[4 * texel];
+    float* sum = &atlas_.Pixels()[3 * texel];
     for (int c = 0; c < 3; ++c) sum[c] += weight * color[c];
-    sum[3] += weight;
+    weights_[texel] += weight;
   }
-  // Linear color; mid-grey where no photo contributed.
-  Eigen::Vector3f Color(size_t texel) const {
-    const float* sum = &sums_[4 * texel];
-    if (!(sum[3] > 0)) return Eigen::Vector3f::Constant(SrgbToLinear(0.5f));
-    return Eigen::Vector3f(sum[0], sum[1], sum[2]) / sum[3];
+  // The atlas in sRGB: the weighted means, mid-grey where no photo contributed.
+  void Finish() {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, weights_.size()), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t texel = range.begin(); texel < range.end(); ++texel) {
+        float* color = &atlas_.Pixels()[3 * texel];
+        const float weight = weights_[texel];
+        for (int c = 0; c < 3; ++c) {
+          const float linear = weight > 0 ? color[c] / weight : SrgbToLinear(0.5f);
+          color[c] = std::clamp(LinearToSrgb(linear), 0.0f, 1.0f);
+        }
+      }
+    });
   }
 
  private:
-  std::vector<float> sums_;
+  Image& atlas_;
+  std::vector<float> weights_;
 };
 
 Image ColorOf(const TextureView& view) {
@@ -246,7 +255,7 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
           t, static_cast<float>(std::pow(ratio, options.blend_exponent)));
     }
   }
-  TexelAccumulator texels_sum(static_cast<size_t>(mesh.atlas.Width()) * static_cast<size_t>(mesh.atlas.Height()));
+  TexelAccumulator texels_sum(mesh.atlas);
   for (size_t v = 0; v < views.size(); ++v) {
     if (uses[v].empty()) continue;
     const TextureView& view = views[v];
@@ -268,19 +277,7 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
       }
     });
   }
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles.size()), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t t = range.begin(); t < range.end(); ++t) {
-      const int cell_x = static_cast<int>(t) % columns * cell, cell_y = static_cast<int>(t) / columns * cell;
-      for (int j = 0; j < cell; ++j) {
-        for (int i = 0; i < cell; ++i) {
-          const Eigen::Vector3f linear = texels_sum.Color(texel_index(t, i, j));
-          for (int c = 0; c < 3; ++c) {
-            mesh.atlas.At(cell_x + i, cell_y + j, c) = std::clamp(LinearToSrgb(linear[c]), 0.0f, 1.0f);
-          }
-        }
-      }
-    }
-  });
+  texels_sum.Finish();
   summary.untextured_triangles = static_cast<size_t>(
       std::count_if(ranked.begin(), ranked.end(), [](const Candidates& c) { return c[0].view < 0; }));
   return mesh;
