@@ -120,7 +120,8 @@ Stage ColorGainsStage(const Workspace& workspace, const std::string& undistort_k
 }
 
 std::string EnsureColorGains(const Workspace& workspace) {
-  if (fs::exists(workspace.ColorGainsFile())) return "";
+  // A workspace without photos (a bare SfM model) blends none.
+  if (fs::exists(workspace.ColorGainsFile()) || !fs::is_directory(workspace.Images())) return "";
   StageGraph graph(workspace, false);
   std::string note;
   graph.Run(ColorGainsStage(workspace, UndistortedModelKey(workspace, graph), &note));

@@ -43,7 +43,8 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
 Stage ColorGainsStage(const Workspace& workspace, const std::string& undistort_key, std::string* note = nullptr);
 
 // Runs the color gains stage through the workspace's graph when the workspace (made before
-// gains were estimated) lacks them; returns what it did, or "" when they were there.
+// gains were estimated) lacks them; returns what it did, or "" when they were there or the
+// workspace has no photos.
 std::string EnsureColorGains(const Workspace& workspace);
 
 // Fusion and mesh take their colors from the photos, corrected by the gains that

@@ -99,6 +99,7 @@ struct SceneRenderer::Impl {
   Eigen::Matrix4f shadow_from_world = Eigen::Matrix4f::Identity();
   Eigen::Matrix4f projector_from_world[kMaxProjectors];
   Eigen::Vector3f projector_centre[kMaxProjectors];
+  Eigen::Vector3f projector_gain[kMaxProjectors];
   Eigen::Vector4f ground_plane = Eigen::Vector4f::Zero();
   float ground_tolerance = 0;
   GpuMesh full_mesh, display_mesh;  // display_mesh is empty without a simplified copy.
@@ -231,6 +232,7 @@ int SceneRenderer::Impl::SetUpProjectors(const ViewCamera& view, const FrameSett
     glBindTexture(GL_TEXTURE_2D, projector_depth[k].texture.Get());
     projector_from_world[k] = clip_from_world;
     projector_centre[k] = CameraCenter(source.cam_from_world).cast<float>();
+    projector_gain[k] = Eigen::Vector3f(source.gain[0], source.gain[1], source.gain[2]);
   }
   glActiveTexture(GL_TEXTURE0);
   return static_cast<int>(chosen.size());
@@ -276,6 +278,7 @@ void SceneRenderer::Impl::UseSurfaceProgram(const GlProgram& program, const View
     const std::string index = std::to_string(k);
     program.Set(("u_projector_from_world[" + index + "]").c_str(), projector_from_world[k]);
     program.Set(("u_projector_centre[" + index + "]").c_str(), projector_centre[k]);
+    program.Set(("u_projector_gain[" + index + "]").c_str(), projector_gain[k]);
   }
   program.Set("u_has_atlas", mesh->atlas.Get() != 0 ? 1 : 0);
   program.Set("u_ground", ground_plane);

@@ -71,6 +71,7 @@ uniform sampler2DShadow u_projector_depth1;
 uniform sampler2DShadow u_projector_depth2;
 uniform mat4 u_projector_from_world[3];
 uniform vec3 u_projector_centre[3];
+uniform vec3 u_projector_gain[3];  // Each photo's color gain: linear RGB to the common exposure.
 uniform float u_projector_pull;  // Fraction of the distance, e.g. 0.003.
 
 vec3 SrgbToLinear(vec3 c) {
@@ -107,7 +108,7 @@ float ShadowVisibility() {
 // A photo projected like a slide: its color and a weight, zero where the projector's depth
 // map says the surface is hidden from that camera, or outside its image.
 vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, vec3 centre,
-             vec3 view_dir) {
+             vec3 gain, vec3 view_dir) {
   vec4 clip = projector_from_world * vec4(v_world, 1.0);
   if (clip.w <= 0.0) return vec4(0.0);
   vec3 ndc = clip.xyz / clip.w;
@@ -123,7 +124,7 @@ vec4 Project(sampler2D photo, sampler2DShadow depth, mat4 projector_from_world, 
   float cosine = max(dot(normalize(centre - v_world), view_dir), 0.0);
   float weight = pow(cosine, 64.0) + 1e-6;
   // Photos are stored top row first; t = 1 - v / H flips into texture coordinates.
-  vec3 color = texture(photo, vec2(uv.x, 1.0 - uv.y)).rgb;
+  vec3 color = texture(photo, vec2(uv.x, 1.0 - uv.y)).rgb * gain;
   return vec4(color * weight, weight);
 }
 
@@ -169,9 +170,9 @@ void main() {
   } else if (u_albedo_source == 3) {
     albedo = SrgbToLinear(v_color);
   } else if (u_albedo_source == 1) {
-    vec4 sum = Project(u_photo0, u_projector_depth0, u_projector_from_world[0], u_projector_centre[0], view_dir);
-    if (u_num_projectors > 1) sum += Project(u_photo1, u_projector_depth1, u_projector_from_world[1], u_projector_centre[1], view_dir);
-    if (u_num_projectors > 2) sum += Project(u_photo2, u_projector_depth2, u_projector_from_world[2], u_projector_centre[2], view_dir);
+    vec4 sum = Project(u_photo0, u_projector_depth0, u_projector_from_world[0], u_projector_centre[0], u_projector_gain[0], view_dir);
+    if (u_num_projectors > 1) sum += Project(u_photo1, u_projector_depth1, u_projector_from_world[1], u_projector_centre[1], u_projector_gain[1], view_dir);
+    if (u_num_projectors > 2) sum += Project(u_photo2, u_projector_depth2, u_projector_from_world[2], u_projector_centre[2], u_projector_gain[2], view_dir);
     if (sum.w > 0.0) {
       // Photos already hold the scene's lighting and shadows: show them as captured.
       albedo = sum.rgb / sum.w;

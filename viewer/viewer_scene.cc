@@ -86,13 +86,14 @@ std::vector<Eigen::Vector3f> Subsample(const std::vector<ColoredPoint>& points, 
   return positions;
 }
 
-std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir) {
+std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path& images_dir,
+                                      const ColorGains& gains) {
   std::vector<ViewerSource> sources;
   const SparseModel model = ReadSparseModel(sparse_dir);
   for (const SparseImage& image : model.Images()) {
     const Camera& camera = model.CameraById(image.camera_id);
     if (!IsProjectionSupported(camera.model)) continue;
-    sources.push_back({image.name, camera, image.cam_from_world, images_dir / image.name});
+    sources.push_back({image.name, camera, image.cam_from_world, images_dir / image.name, gains.Of(image.name)});
   }
   return sources;
 }
@@ -205,9 +206,9 @@ ViewerScene LoadViewerScene(const fs::path& workspace) {
   }
   const SceneFolder scene_folder{workspace};
   if (DetectSparseFormat(ws.Sparse())) {
-    scene.sources = ReadSources(ws.Sparse(), ws.Images());
+    scene.sources = ReadSources(ws.Sparse(), ws.Images(), ReadWorkspaceColorGains(workspace));
   } else if (DetectSparseFormat(scene_folder.Training().sparse)) {
-    scene.sources = ReadSources(scene_folder.Training().sparse, scene_folder.Training().images);
+    scene.sources = ReadSources(scene_folder.Training().sparse, scene_folder.Training().images, {});
   }
   FinishViewerScene(scene);
   return scene;

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "core/camera.h"
+#include "core/color_gains.h"
 #include "core/pose.h"
 #include "geometry/obj.h"
 #include "geometry/ground_plane.h"
@@ -25,6 +26,8 @@ struct ViewerSource {
   Camera camera;
   Rigid3d cam_from_world;
   std::filesystem::path image_path;  // May not exist: the view is then never projected.
+  // Its color gain (core/color_gains.h): projected photos meet without exposure steps.
+  RgbGain gain = {1, 1, 1};
 };
 
 struct ColoredPoint {
