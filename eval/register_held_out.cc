@@ -67,10 +67,17 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
       "--image_list_path", (work_dir / "image_list.txt").string(),
       "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "2000",
       "--SiftExtraction.max_num_features", "4096"};
-  // One shared camera (the usual capture): the held-out photos are taken with it.
-  if (model.Cameras().size() == 1) {
-    extract.insert(extract.end(), {"--ImageReader.existing_camera_id",
-                                   std::to_string(model.Cameras().front().id)});
+  // One shared camera (the usual capture, or one camera per photo with the same intrinsics, as
+  // calibrated datasets list them): the held-out photos are taken with it. Registering them
+  // with a camera of their own instead would estimate its focal length, and trade it against
+  // the pose.
+  const Camera& first = model.Cameras().front();
+  const bool one_camera = std::all_of(model.Cameras().begin(), model.Cameras().end(), [&](const Camera& camera) {
+    return camera.model == first.model && camera.width == first.width && camera.height == first.height &&
+           camera.params == first.params;
+  });
+  if (one_camera) {
+    extract.insert(extract.end(), {"--ImageReader.existing_camera_id", std::to_string(first.id)});
   } else {
     extract.insert(extract.end(), {"--ImageReader.single_camera", "1"});
   }
@@ -108,7 +115,7 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   const std::map<std::string, std::string> staged = StagedNames(names, in_database);
   std::string pairs, list;
   Hasher key_hasher;
-  key_hasher.Add("held-out-2").Add(static_cast<uint64_t>(fs::file_size(database)));
+  key_hasher.Add("held-out-3").Add(static_cast<uint64_t>(fs::file_size(database)));
   std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
   std::sort(model_files.begin(), model_files.end());
   for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
