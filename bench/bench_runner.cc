@@ -227,9 +227,9 @@ void Bench::Render() {
   settings.push_back({"naive", 1, "inpaint", 0, true});
   if (real_) {
     // Each evaluation renders full-size held-out photos: the knobs that matter on them only.
-    settings = {{"mesh", 1, "depth-aware"}, {"mesh", 2, "depth-aware"}, {"mesh", 4, "depth-aware", 2},
-                {"mesh", 4, "depth-aware", 2}, {"mesh", 4, "none"}, {"naive", 1, "inpaint", 0, true}};
-    settings[3].color_gains = false;
+    settings = {{"mesh", 2, "depth-aware"}, {"mesh", 4, "depth-aware", 2}, {"mesh", 4, "depth-aware", 2},
+                {"naive", 1, "inpaint", 0, true}};
+    settings[2].color_gains = false;
   }
   for (const Setting& setting : settings) {
     const bool bicubic = setting.texture_filter != "auto";

@@ -64,7 +64,9 @@ std::string DescribeDepthResolution(const DepthRequest& request, int width, int 
   if (request.max_size > 0) {
     why = "--mvs-max-size " + std::to_string(request.max_size);
   } else if (request.scale > 0) {
-    why = "--mvs-scale " + std::to_string(request.scale);
+    char scale_text[32];
+    std::snprintf(scale_text, sizeof scale_text, "%g", request.scale);
+    why = std::string("--mvs-scale ") + scale_text;
   } else {
     why = std::string(QualityName(request.quality)) + " caps the long side at " +
           std::to_string(options.max_image_size) + " px (docs/depth.md: the best error for the time on real photos)";
