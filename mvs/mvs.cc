@@ -45,6 +45,12 @@ Camera WorkingCamera(const Camera& camera, double scale) {
                            camera.PrincipalX() * sx, camera.PrincipalY() * sy);
 }
 
+// The camera `image` is estimated with at the working resolution `options` choose for it.
+Camera WorkingCameraOf(const SparseModel& model, const SparseImage& image, const MvsOptions& options) {
+  const Camera& camera = model.CameraById(image.camera_id);
+  return WorkingCamera(camera, options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+}
+
 // The photo resampled to its working camera's size (area averaging, no aliasing).
 GrayImage ResampleTo(const GrayImage& image, const Camera& camera) {
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
@@ -234,9 +240,8 @@ std::map<uint32_t, StereoView> LoadStereoViews(const Workspace& ws, const Sparse
       continue;
     }
     const SparseImage& image = model.ImageById(id);
-    const Camera& camera = model.CameraById(image.camera_id);
     StereoView& view = views[id];
-    view.camera = WorkingCamera(camera, options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+    view.camera = WorkingCameraOf(model, image, options);
     view.cam_from_world = image.cam_from_world;
     view.image = ResampleTo(LoadGray(ws.Image(image.name)), view.camera);
   }
@@ -320,10 +325,8 @@ MvsViewReport FilterAndWriteView(const Workspace& ws, const SparseModel& model, 
                                  const std::set<std::string>& estimated, const MvsOptions& options) {
   const auto working_view = [&](uint32_t id) {
     const SparseImage& image = model.ImageById(id);
-    const Camera& camera = model.CameraById(image.camera_id);
     StereoView stereo_view;
-    stereo_view.camera =
-        WorkingCamera(camera, options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height)));
+    stereo_view.camera = WorkingCameraOf(model, image, options);
     stereo_view.cam_from_world = image.cam_from_world;
     return stereo_view;
   };
