@@ -52,7 +52,7 @@ Image ExposureMatched(const Image& render, const Image& truth, const std::vector
     if (!mask[p]) continue;
     for (size_t c = 0; c < 3; ++c) {
       const double r = render.Pixels()[3 * p + c];
-      cross[c] += r * truth_linear.Pixels()[truth_linear.Channels() * p + c];
+      cross[c] += r * static_cast<double>(truth_linear.Pixels()[static_cast<size_t>(truth_linear.Channels()) * p + c]);
       square[c] += r * r;
     }
   }

@@ -500,15 +500,16 @@ const std::vector<uint8_t>& WarpScratch::Background() const {
   return data_->background_used != nullptr ? *data_->background_used : kNone;
 }
 
-void PrepareSource(SourceView* source, const ForwardWarpOptions& options) {
+void PrepareSource(SourceView* source, const ForwardWarpOptions& options, const RgbGain& gain) {
   options.Check();
   CheckSourceView(*source);
-  MakeTexture(source->color, &source->texture);
   if (options.background_at_infinity) {
     const auto step = static_cast<float>(options.background_max_step);
     source->background = MarkBackground(source->depth, source->color, step);
     source->background_step = step;
   }
+  ApplyGain(gain, source->color);
+  MakeTexture(source->color, &source->texture);
 }
 
 void ForwardWarp(const SourceView& source, const PosedCamera& target,

@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/color_gains.h"
 #include "reproject/view.h"
 
 namespace parallax {
@@ -149,10 +150,12 @@ class WarpScratch {
 
 // Makes what every warp of the source would otherwise make again, for the warps to share:
 // source->texture, and source->background (MarkBackground of its depth and color, with the
-// options' background_max_step) where the options warp background at infinity. Call again
-// whenever the depth or color changes. Throws std::invalid_argument for a source
-// CheckSourceView refuses or bad options.
-void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {});
+// options' background_max_step) where the options warp background at infinity. With a
+// `gain` (core/color_gains.h), the background is marked on the photo as taken and the color is
+// then corrected by it, so the correction never moves the background. Call again whenever the
+// depth or color changes. Throws std::invalid_argument for a source CheckSourceView refuses or
+// bad options.
+void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {}, const RgbGain& gain = {1, 1, 1});
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
 // behind the target camera are dropped; source pixels with depth 0 are background (see

@@ -197,13 +197,7 @@ const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp)
     }
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
-    PrepareSource(view.get(), warp);
-    if (gains_.Of(name) != RgbGain{1, 1, 1}) {
-      const std::vector<uint8_t> background = view->background;
-      ApplyGain(gains_.Of(name), view->color);
-      PrepareSource(view.get(), warp);
-      view->background = background;
-    }
+    PrepareSource(view.get(), warp, gains_.Of(name));
     slot = std::move(view);
   }
   return *slot;
