@@ -88,10 +88,10 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
       sampled[p] = c == PixelClass::kCovered || c == PixelClass::kBackground;
     }
     const HoleMetrics& metrics = view.result.metrics;
-    const NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
+    NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
                                Psnr(render, truth_image, sampled),
                                Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
-                               metrics.hole_ratio};
+                               metrics.hole_ratio, view.sources};
     evaluation.per_view.push_back(score);
     evaluation.psnr_mean += score.psnr;
     evaluation.ssim_mean += score.ssim;

@@ -18,6 +18,7 @@ struct NovelViewScore {
   double psnr_valid = 0;
   double psnr_exposure_matched = 0;
   double hole_ratio = 0;
+  std::vector<std::string> sources;  // The views it was rendered from, best first.
 };
 
 struct NovelEvaluation {

@@ -194,6 +194,16 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                      {"color_gains", novel.color_gains},
                      {"poses", novel.poses},
                      {"poses_registered", novel.poses_registered}};
+    nlohmann::json& per_view = json["novel"]["per_view"] = nlohmann::json::array();
+    for (const NovelViewScore& view : result.per_view) {
+      per_view.push_back({{"name", view.name},
+                          {"psnr", view.psnr},
+                          {"ssim", view.ssim},
+                          {"psnr_valid", view.psnr_valid},
+                          {"psnr_exposure_matched", view.psnr_exposure_matched},
+                          {"hole_ratio", view.hole_ratio},
+                          {"sources", view.sources}});
+    }
   }
   if (!evaluation.not_scored.empty()) json["not_scored"] = evaluation.not_scored;
   if (evaluation.reconstruct_timings_s) json["timings_s"] = *evaluation.reconstruct_timings_s;

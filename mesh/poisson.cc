@@ -118,6 +118,7 @@ std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
 void MeshOptions::Check() const {
   RequireOption(poisson_depth >= 5 && poisson_depth <= 14, "MeshOptions.poisson_depth", poisson_depth, "[5, 14]");
   RequireOption(max_cells_from_data > 0, "MeshOptions.max_cells_from_data", max_cells_from_data, "> 0");
+  RequireOption(poisson_trim >= 0, "MeshOptions.poisson_trim", poisson_trim, ">= 0");
   RequireOption(display_max_triangles >= 1, "MeshOptions.display_max_triangles",
                 static_cast<double>(display_max_triangles), ">= 1");
   texture.Check();
@@ -143,7 +144,8 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   const fs::path temporary = ws.PoissonMeshScratch();
   colmap.Run("poisson_mesher",
              {"--input_path", fused.string(), "--output_path", temporary.string(),
-              "--PoissonMeshing.depth", std::to_string(options.poisson_depth)},
+              "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
+              std::to_string(options.poisson_trim)},
              ws.Log("mesh"), "mesh", 0, progress);
   fs::rename(temporary, poisson);
 

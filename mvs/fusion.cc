@@ -9,6 +9,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/atomic_file.h"
 #include "core/color_gains.h"
 #include "core/depth_map.h"
@@ -17,6 +19,7 @@
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "core/check.h"
+#include "mvs/working_resolution.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -36,6 +39,39 @@ struct FusionView {
     return {normals.values[i], normals.values[Pixels() + i], normals.values[2 * Pixels() + i]};
   }
 };
+
+// The camera a view is fused with.
+Camera FusionCamera(const Camera& camera, const FusionOptions& options) {
+  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  return WorkingCamera(camera, WorkingScale(width, height, options.image_scale, options.max_image_size));
+}
+
+// For each pixel of a working_width x working_height grid over a width x height one, the index
+// of the fine pixel its centre falls in: the depth stage's maps were upsampled to the photo's
+// size by nearest neighbour, so these pixels hold its estimates as they were.
+std::vector<size_t> FinePixelsAtCentres(int width, int height, int working_width, int working_height) {
+  std::vector<size_t> fine;
+  fine.reserve(static_cast<size_t>(working_width) * static_cast<size_t>(working_height));
+  for (int y = 0; y < working_height; ++y) {
+    const int fy = std::min(height - 1, static_cast<int>((y + 0.5) * height / working_height));
+    for (int x = 0; x < working_width; ++x) {
+      const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / working_width));
+      fine.push_back(static_cast<size_t>(fy) * static_cast<size_t>(width) + static_cast<size_t>(fx));
+    }
+  }
+  return fine;
+}
+
+// `image` resampled to width x height by area averaging (no aliasing).
+Image ResampleArea(const Image& image, int width, int height) {
+  if (image.Width() == width && image.Height() == height) return image;
+  const int type = CV_32FC(image.Channels());
+  const cv::Mat full(image.Height(), image.Width(), type, const_cast<float*>(image.Pixels().data()));
+  Image small(width, height, image.Channels());
+  cv::Mat resampled(height, width, type, small.Pixels().data());
+  cv::resize(full, resampled, resampled.size(), 0, 0, cv::INTER_AREA);
+  return small;
+}
 
 // The model's images that have a depth map and a geometric normal map.
 std::vector<const SparseImage*> ViewsWithDepth(const Workspace& ws, const SparseModel& model) {
@@ -82,8 +118,9 @@ std::vector<std::vector<size_t>> Neighbours(const SparseModel& model, const std:
 class FusionViewCache {
  public:
   FusionViewCache(const Workspace& ws, const SparseModel& model, const std::vector<const SparseImage*>& views,
-                  size_t capacity)
-      : ws_(ws), model_(model), views_(views), gains_(ReadWorkspaceColorGains(ws.Root())), capacity_(capacity) {}
+                  const FusionOptions& options)
+      : ws_(ws), model_(model), views_(views), options_(options), gains_(ReadWorkspaceColorGains(ws.Root())),
+        capacity_(static_cast<size_t>(options.max_neighbours) + 1) {}
 
   // Every view of `wanted` resident at once; pointers stay valid until the next call.
   std::map<size_t, FusionView*> Acquire(const std::vector<size_t>& wanted) {
@@ -122,25 +159,39 @@ class FusionViewCache {
   }
 
   FusionView Load(const SparseImage& image) const {
+    const Camera& camera = model_.CameraById(image.camera_id);
+    const DepthMap depth = ReadDepthExr(ws_.Depth(image.name));
+    const DenseArray normals = ReadColmapArray(ws_.StereoNormalMap(image.name, StereoPass::kGeometric));
+    const Image color = ReadImage(ws_.Image(image.name));
+    const int width = depth.Width(), height = depth.Height();
+    if (width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height) ||
+        normals.width != width || normals.height != height || normals.channels != 3 || color.Width() != width ||
+        color.Height() != height) {
+      throw BadInputError("fusion: depth, normal map, image and camera of " + image.name + " differ in size");
+    }
     FusionView view;
-    view.camera = model_.CameraById(image.camera_id);
+    view.camera = FusionCamera(camera, options_);
     view.cam_from_world = image.cam_from_world;
     view.world_from_cam = image.cam_from_world.rotation.conjugate().toRotationMatrix();
-    view.depth = ReadDepthExr(ws_.Depth(image.name));
-    view.normals = ReadColmapArray(ws_.StereoNormalMap(image.name, StereoPass::kGeometric));
-    view.color = SrgbToLinear(ReadImage(ws_.Image(image.name)));
-    ApplyGain(gains_.Of(image.name), view.color);
-    if (view.normals.width != view.depth.Width() || view.normals.height != view.depth.Height() ||
-        view.normals.channels != 3 || view.color.Width() != view.depth.Width() ||
-        view.color.Height() != view.depth.Height()) {
-      throw BadInputError("fusion: depth, normal map and image of " + image.name + " differ in size");
+    const int working_width = static_cast<int>(view.camera.width);
+    const int working_height = static_cast<int>(view.camera.height);
+    const std::vector<size_t> fine = FinePixelsAtCentres(width, height, working_width, working_height);
+    const size_t fine_pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    view.depth = DepthMap(working_width, working_height);
+    view.normals = {working_width, working_height, 3, std::vector<float>(3 * fine.size())};
+    for (size_t i = 0; i < fine.size(); ++i) {
+      view.depth.Values()[i] = depth.Values()[fine[i]];
+      for (size_t c = 0; c < 3; ++c) view.normals.values[c * fine.size() + i] = normals.values[c * fine_pixels + fine[i]];
     }
+    view.color = ResampleArea(SrgbToLinear(color), working_width, working_height);
+    ApplyGain(gains_.Of(image.name), view.color);
     return view;
   }
 
   const Workspace& ws_;
   const SparseModel& model_;
   const std::vector<const SparseImage*>& views_;
+  const FusionOptions& options_;
   const ColorGains gains_;
   const size_t capacity_;
   std::map<size_t, Entry> resident_;
@@ -215,6 +266,9 @@ void FusionOptions::Check() const {
   RequireOption(max_relative_depth > 0, "FusionOptions.max_relative_depth", max_relative_depth, "> 0");
   RequireOption(max_normal_angle_deg > 0 && max_normal_angle_deg <= 180, "FusionOptions.max_normal_angle_deg",
                 max_normal_angle_deg, "(0, 180]");
+  RequireOption(image_scale >= 0.25 && image_scale <= 1, "FusionOptions.image_scale", image_scale, "[0.25, 1]");
+  RequireOption(max_image_size == 0 || max_image_size >= 64, "FusionOptions.max_image_size", max_image_size,
+                "0 (no cap) or >= 64");
 }
 
 std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOptions& options,
@@ -224,10 +278,10 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
   const SparseModel model = ReadSparseModel(ws.Sparse());
   const std::vector<const SparseImage*> views = ViewsWithDepth(ws, model);
   const std::vector<std::vector<size_t>> neighbours = Neighbours(model, views, options.max_neighbours);
-  FusionViewCache cache(ws, model, views, static_cast<size_t>(options.max_neighbours) + 1);
+  FusionViewCache cache(ws, model, views, options);
   UsedPixels used(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
-    const Camera& camera = model.CameraById(views[i]->camera_id);
+    const Camera camera = FusionCamera(model.CameraById(views[i]->camera_id), options);
     used[i].assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), false);
   }
   std::vector<FusedPoint> points;

@@ -23,6 +23,11 @@ struct FusionOptions {
   // Each view is merged with the views that share the most sparse points with it, at most
   // this many; only they are in memory with it, so memory does not grow with the photo count.
   int max_neighbours = 8;
+  // The resolution views are fused at (mvs/working_resolution.h): the depth stage's, since its
+  // maps hold no more detail at the photo's size; memory and points then follow the working
+  // size, not the photo's megapixels. Colors are area-averaged down to it.
+  double image_scale = 1;
+  int max_image_size = 0;
   void Check() const;
 };
 
@@ -34,7 +39,8 @@ struct FusedPoint {
 };
 
 // Reads <ws>/sparse, <ws>/images, <ws>/depth/<stem>.exr and the geometric normal maps under
-// <ws>/stereo/normal_maps (streamed: at most max_neighbours + 1 views in memory), colors
+// <ws>/stereo/normal_maps (streamed: at most max_neighbours + 1 views in memory, each at the
+// working resolution), colors
 // corrected by <ws>/color_gains.json when present. Views without a depth map are left out.
 // Deterministic.
 std::vector<FusedPoint> FuseWorkspace(const std::filesystem::path& workspace,

@@ -33,18 +33,6 @@ GrayImage LoadGray(const fs::path& path) {
   return gray;
 }
 
-// The camera of a photo resampled to `scale` of its size: pixel coordinates (origin at the
-// image corner) scale by the exact size ratio per axis.
-Camera WorkingCamera(const Camera& camera, double scale) {
-  if (scale == 1) return camera;
-  const auto width = static_cast<uint64_t>(std::max(1L, std::lround(static_cast<double>(camera.width) * scale)));
-  const auto height = static_cast<uint64_t>(std::max(1L, std::lround(static_cast<double>(camera.height) * scale)));
-  const double sx = static_cast<double>(width) / static_cast<double>(camera.width);
-  const double sy = static_cast<double>(height) / static_cast<double>(camera.height);
-  return MakePinholeCamera(camera.id, width, height, camera.FocalX() * sx, camera.FocalY() * sy,
-                           camera.PrincipalX() * sx, camera.PrincipalY() * sy);
-}
-
 // The camera `image` is estimated with at the working resolution `options` choose for it.
 Camera WorkingCameraOf(const SparseModel& model, const SparseImage& image, const MvsOptions& options) {
   const Camera& camera = model.CameraById(image.camera_id);
@@ -128,9 +116,7 @@ void MvsOptions::Check() const {
 }
 
 double MvsOptions::ScaleFor(int width, int height) const {
-  const int long_side = std::max(width, height);
-  if (max_image_size == 0 || long_side <= 0) return image_scale;
-  return std::min(image_scale, static_cast<double>(max_image_size) / static_cast<double>(long_side));
+  return WorkingScale(width, height, image_scale, max_image_size);
 }
 
 int MaxImageSizeFor(Quality quality) {

@@ -14,6 +14,7 @@
 #include "mvs/patch_match.h"
 #include "core/quality.h"
 #include "mvs/view_selection.h"
+#include "mvs/working_resolution.h"
 
 namespace parallax {
 

@@ -20,8 +20,8 @@ namespace {
 
 // Bump when a stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-6";
-constexpr const char* kFusionVersion = "fusion-3";
-constexpr const char* kMeshVersion = "mesh-2";
+constexpr const char* kFusionVersion = "fusion-4";
+constexpr const char* kMeshVersion = "mesh-3";
 constexpr const char* kColorGainsVersion = "color-gains-1";
 
 // The working scale of every view, when one is below 1: what the results depend on, rather
@@ -130,14 +130,18 @@ std::string EnsureColorGains(const Workspace& workspace) {
   return note;
 }
 
-Stage FusionStage(const Workspace& workspace, const std::string& depth_key,
+Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
                   const std::string& color_gains_key, Progress& progress) {
   Stage stage;
   stage.name = "fusion";
   stage.key = Hasher().Add(depth_key).Add(color_gains_key).Add(kFusionVersion).Hex();
   stage.outputs = {workspace.Fused()};
-  stage.run = [workspace, &progress] {
-    WritePly(workspace.Fused(), FuseWorkspace(workspace.Root(), {}, progress));
+  const MvsOptions mvs = MvsOptionsOf(request);
+  FusionOptions options;
+  options.image_scale = mvs.image_scale;
+  options.max_image_size = mvs.max_image_size;
+  stage.run = [workspace, options, &progress] {
+    WritePly(workspace.Fused(), FuseWorkspace(workspace.Root(), options, progress));
   };
   return stage;
 }

@@ -48,8 +48,9 @@ Stage ColorGainsStage(const Workspace& workspace, const std::string& undistort_k
 std::string EnsureColorGains(const Workspace& workspace);
 
 // Fusion and mesh take their colors from the photos, corrected by the gains that
-// `color_gains_key` identifies.
-Stage FusionStage(const Workspace& workspace, const std::string& depth_key,
+// `color_gains_key` identifies. Fusion works at the depth stage's resolution (`request`, whose
+// effect on the maps `depth_key` already holds).
+Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
                   const std::string& color_gains_key, Progress& progress);
 
 Stage MeshStage(const Workspace& workspace, const std::string& depth_key,

@@ -196,7 +196,7 @@ void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, Sta
   const Stage color_gains = ColorGainsStage(paths, undistort_key, &gains_note);
   graph.Run(color_gains);
   if (!gains_note.empty()) summary.notes.push_back(gains_note);
-  graph.Run(FusionStage(paths, depth.key, color_gains.key, sfm.progress));
+  graph.Run(FusionStage(paths, depth_request, depth.key, color_gains.key, sfm.progress));
   if (!options.build_mesh) {
     summary.notes.push_back("mesh: not built (--no-mesh)");
     return;

@@ -189,6 +189,17 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_GT(ours.points, 50000u);
   EXPECT_LT(ours.median_relative_distance, 0.005);
   EXPECT_GT(ours.within_1pct, 0.9);
+  // Fused at half the photos' size, as the depth stage's cap has large photos fused: a
+  // quarter of the points (each working pixel one), on the same surfaces.
+  FusionOptions half_size;
+  half_size.max_image_size = static_cast<int>(std::max(model.Cameras().front().width, model.Cameras().front().height) / 2);
+  std::vector<Eigen::Vector3f> coarse_points;
+  for (const FusedPoint& point : FuseWorkspace(workspace.Path(), half_size, progress)) coarse_points.push_back(point.position);
+  const CloudAccuracy coarse_accuracy = MeasureCloud(coarse_points, truth, scene.Training().depth, {});
+  EXPECT_GT(coarse_accuracy.points, ours.points / 6);
+  EXPECT_LT(coarse_accuracy.points, ours.points / 3);
+  EXPECT_LT(coarse_accuracy.median_relative_distance, 0.005);
+  EXPECT_GT(coarse_accuracy.within_1pct, 0.85);
   const std::filesystem::path colmap_ply = workspace.Path() / "colmap_fused.ply";
   Colmap().Run("stereo_fusion",
                {"--workspace_path", workspace.Path().string(), "--workspace_format", "COLMAP",
