@@ -8,6 +8,7 @@
 #include "apps/novel_view_options.h"
 #include "apps/terminal_progress.h"
 #include "core/atomic_file.h"
+#include "core/workspace_lock.h"
 #include "eval/workspace_evaluation.h"
 #include "pipeline/dense_stages.h"
 
@@ -139,6 +140,8 @@ void RegisterEvaluateCommand(CLI::App& app) {
     arguments->options.align = !arguments->no_align;
     arguments->options.novel.Resolve();
     const Workspace workspace(arguments->workspace);
+    // It writes evaluation/ (and missing color gains) into the workspace.
+    const WorkspaceLock lock(workspace.Root(), LockMode::kExclusive, "evaluate");
     WorkspaceEvaluation evaluation;
     if (arguments->options.novel.color_gains && !arguments->options.gt_sources) {
       const std::string note = EnsureColorGains(workspace);

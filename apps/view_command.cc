@@ -9,6 +9,7 @@
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
+#include "core/workspace_lock.h"
 #include "eval/shadow_reference.h"
 #include "viewer/screenshot.h"
 #include "viewer/view_cameras.h"
@@ -138,7 +139,10 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {
-    const ViewerScene scene = LoadViewerScene(a->workspace);
+    const ViewerScene scene = [&] {
+      const WorkspaceLock lock(a->workspace, LockMode::kShared, "view");  // While it reads.
+      return LoadViewerScene(a->workspace);
+    }();
     const FrameSettings settings = Settings(*a, scene);
     if (!a->screenshot.empty()) {
       PrintScreenshot(*a, scene, settings);

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
+#include "core/workspace_lock.h"
 #include "pipeline/dense_stages.h"
 #include "pipeline/sfm_stages.h"
 
@@ -249,6 +250,10 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   std::optional<SparseModel> known;
   if (!options.known_cameras.empty()) known = ReadSparseModel(options.known_cameras);
   if (!options.dry_run) CheckWorkspaceWritable(workspace);
+  std::optional<WorkspaceLock> lock;
+  if (!options.dry_run || fs::is_directory(workspace)) {
+    lock.emplace(workspace, options.dry_run ? LockMode::kShared : LockMode::kExclusive, "reconstruct");
+  }
 
   ReconstructSummary summary;
   summary.images_found = static_cast<int>(photos.photos.size());

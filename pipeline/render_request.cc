@@ -2,10 +2,12 @@
 
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "core/atomic_file.h"
 #include "core/workspace.h"
+#include "core/workspace_lock.h"
 #include "mvs/mvs.h"
 #include "pipeline/dense_stages.h"
 #include "pipeline/stage_graph.h"
@@ -37,7 +39,7 @@ RequestStage Skipped(const std::string& name, const std::string& why) { return {
 // the source views the targets use, and for no other view.
 void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& library,
                           const std::vector<NamedCamera>& targets,
-                          const SourceSelectionOptions& selection, Progress& progress,
+                          const SourceSelectionOptions& selection, WorkspaceLock& lock, Progress& progress,
                           RenderSummary& summary) {
   std::set<std::string> missing;
   for (const NamedCamera& target : targets) {
@@ -52,6 +54,7 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
   }
   // The depth stage of the workspace's graph, for these views: recorded in stages.json like
   // reconstruct's, at reconstruct's default quality.
+  lock.MakeExclusive();
   StageGraph graph(workspace, false);
   DepthRequest request;
   request.views.assign(missing.begin(), missing.end());
@@ -71,10 +74,11 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
 
 // The workspace's color gains, estimated through its graph when a workspace made before they
 // existed lacks them.
-RequestStage ColorGainsStep(const fs::path& input, bool scene_folder, bool wanted) {
+RequestStage ColorGainsStep(const fs::path& input, bool scene_folder, bool wanted, WorkspaceLock* lock) {
   if (scene_folder) return Skipped("color_gains", "a scene folder: its photos are used as they are");
   if (!wanted) return Skipped("color_gains", "--no-color-gains: photos blended as they are");
   const Workspace workspace(input);
+  if (!fs::exists(workspace.ColorGainsFile())) lock->MakeExclusive();
   const std::string note = EnsureColorGains(workspace);
   if (note.empty()) return Skipped("color_gains", "already estimated: " + workspace.ColorGainsFile().string());
   return Ran("color_gains", note);
@@ -118,7 +122,10 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   const SceneFolder scene{input};
   const bool scene_folder = fs::is_directory(scene.GroundTruth());
   ViewSetPaths source_paths = SourcePathsFor(input);
-  summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains));
+  // A workspace is read under a shared lock, and written (missing gains or depth) only alone.
+  std::optional<WorkspaceLock> lock;
+  if (!scene_folder) lock.emplace(input, LockMode::kShared, "render");
+  summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains, lock ? &*lock : nullptr));
   if (!settings.color_gains) source_paths.color_gains.clear();
   SourceLibrary library(source_paths);
   const std::vector<NamedCamera> targets =
@@ -128,7 +135,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   if (scene_folder) {
     summary.stages.push_back(Skipped("depth", "a scene folder: its ground-truth depth maps are used"));
   } else {
-    EstimateMissingDepth(Workspace(input), library, targets, settings.selection, progress, summary);
+    EstimateMissingDepth(Workspace(input), library, targets, settings.selection, *lock, progress, summary);
   }
   // What `reconstruct` would also make, and a request for novel views alone does not need.
   summary.stages.push_back(Skipped("fusion", "novel views warp each source's depth map; no fused cloud is needed"));

@@ -1,5 +1,6 @@
 // No data lost: `parallax reconstruct` killed with SIGKILL in the middle of a stage leaves no
-// truncated file under a final name, and a re-run completes, redoing only what was cut short.
+// truncated file under a final name, and a re-run completes, redoing only what was cut short;
+// while it runs, no other process writes the workspace.
 #include <csignal>
 #include <chrono>
 #include <map>
@@ -75,6 +76,20 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
                         const_cast<char* const*>(argv), environ), 0);
   posix_spawnattr_destroy(&attributes);
 
+  // One writer: once the run holds the workspace, a second reconstruct is turned away, naming
+  // the run (and a render, below, once the workspace has cameras to render from).
+  const std::string holder = "reconstruct " + std::to_string(pid);
+  const fs::path lock_file = workspace / ".lock";
+  const auto lock_deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  while (std::chrono::steady_clock::now() < lock_deadline &&
+         !(fs::exists(lock_file) && ReadFileBytes(lock_file).starts_with(holder))) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const std::string refusal = "is being written by reconstruct (pid " + std::to_string(pid) + ")";
+  const CliResult second = RunParallax("reconstruct " + Quote(photos) + " " + Quote(ws) + " --no-mesh");
+  EXPECT_EQ(second.exit_code, 2) << second.output;
+  EXPECT_NE(second.output.find(refusal), std::string::npos) << second.output;
+
   // Kill once the depth stage has written some of its 12 maps, not all. The deadline only
   // bounds a failing run: about 10 s reach that point, the sanitized build on a busy machine
   // took more than 3 minutes.
@@ -90,6 +105,12 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
     if (waitpid(pid, &status, WNOHANG) == pid) break;  // Finished early: nothing to kill.
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  if (mid_depth) {
+    const CliResult render =
+        RunParallax("render " + Quote(ws) + " --path orbit:2 --out " + Quote((dir.Path() / "render").string()));
+    EXPECT_EQ(render.exit_code, 2) << render.output;
+    EXPECT_NE(render.output.find(refusal), std::string::npos) << render.output;
+  }
   ::kill(-pid, SIGKILL);
   waitpid(pid, nullptr, 0);
   ASSERT_TRUE(mid_depth) << "the depth stage was never caught half-done";
@@ -97,6 +118,7 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   EXPECT_EQ(stages.find("\"depth\""), std::string::npos) << "an interrupted stage is not done";
   ExpectEveryFileComplete(workspace);
 
+  // The killed run's lock went with it.
   const CliResult rerun = RunParallax("reconstruct " + Quote(photos) + " " + Quote(ws) + " --no-mesh");
   ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
   // SfM stages were complete and are skipped; the depth stage runs again.
