@@ -1,6 +1,8 @@
 #include "sfm/photo_set.h"
 
 #include <algorithm>
+#include <cstdio>
+#include <map>
 
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
@@ -32,6 +34,14 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   photo.width = spec.width;
   photo.height = spec.height;
   if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
+  const double megapixels = static_cast<double>(spec.width) * static_cast<double>(spec.height) / 1e6;
+  if (megapixels > kMaxPhotoMegapixels) {
+    char reason[160];
+    std::snprintf(reason, sizeof reason, "is %dx%d (%.0f MP), over the %.0f MP limit (a decompression bomb, or a "
+                  "scan or panorama to downscale first); not decoded", spec.width, spec.height, megapixels,
+                  kMaxPhotoMegapixels);
+    return std::string(reason);
+  }
   const float focal_35mm = spec.get_float_attribute("Exif:FocalLengthIn35mmFilm", 0.0f);
   if (focal_35mm > 0) {
     photo.exif_focal_px = static_cast<double>(focal_35mm) / 36.0 * std::max(spec.width, spec.height);
@@ -82,12 +92,19 @@ PhotoSet ScanPhotos(const fs::path& dir) {
     problems[i] = CheckPhoto(dir / names[i], candidates[i]);
   });
   PhotoSet set;
+  std::map<uint64_t, std::string> first_with_content;
   for (size_t i = 0; i < names.size(); ++i) {
     if (problems[i]) {
       set.skipped.push_back({names[i], *problems[i]});
-    } else {
-      set.photos.push_back(std::move(candidates[i]));
+      continue;
     }
+    // A copy adds no view: SfM would match it to its original with no baseline.
+    const auto [first, unique] = first_with_content.emplace(candidates[i].content_hash, names[i]);
+    if (!unique) {
+      set.skipped.push_back({names[i], "is an identical copy of " + first->second});
+      continue;
+    }
+    set.photos.push_back(std::move(candidates[i]));
   }
   if (set.photos.size() < 2) {
     std::string message = "photo folder " + dir.string() + " has " +

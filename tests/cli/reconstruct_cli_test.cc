@@ -78,6 +78,59 @@ TEST(ReconstructCli, UnreadableFilesAreSkippedWithAWarningWhenEnoughImagesRemain
   EXPECT_NE(result.output.find("features     will run"), std::string::npos) << result.output;
 }
 
+// A JPEG whose header claims width x height (the frame marker's fields), its data that of a
+// 64x64 photo: what a decompression bomb looks like before it is decoded.
+void WriteJpegClaiming(const fs::path& path, int width, int height) {
+  WriteImage(path, ReadImage(kSmallImages / "0000.png"), PixelFormat::kUint8);
+  std::string bytes = [&] {
+    std::ifstream file(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(file), {});
+  }();
+  for (size_t i = 0; i + 9 < bytes.size(); ++i) {
+    const auto marker = static_cast<unsigned char>(bytes[i + 1]);
+    if (static_cast<unsigned char>(bytes[i]) == 0xFF && (marker == 0xC0 || marker == 0xC2)) {
+      bytes[i + 5] = static_cast<char>(height >> 8), bytes[i + 6] = static_cast<char>(height & 0xFF);
+      bytes[i + 7] = static_cast<char>(width >> 8), bytes[i + 8] = static_cast<char>(width & 0xFF);
+      break;
+    }
+  }
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(ReconstructCli, AnImageOverThePixelLimitIsSkippedFromItsHeader) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  for (const char* name : {"0000.png", "0001.png", "0002.png"}) fs::copy_file(kSmallImages / name, photos / name);
+  WriteJpegClaiming(photos / "bomb.jpg", 60000, 60000);
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws", "--dry-run"));
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("plan: 3 photos"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("skipped bomb.jpg: it is 60000x60000 (3600 MP), over the 128 MP limit"),
+            std::string::npos)
+      << result.output;
+}
+
+TEST(ReconstructCli, IdenticalCopiesAreSkippedAndCopiesAloneExitTwo) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  for (const char* name : {"0000.png", "0001.png", "0002.png"}) fs::copy_file(kSmallImages / name, photos / name);
+  fs::copy_file(kSmallImages / "0001.png", photos / "0001 copy.png");
+  const CliResult some = RunParallax(Reconstruct(photos, dir.Path() / "ws", "--dry-run"));
+  EXPECT_EQ(some.exit_code, 0) << some.output;
+  EXPECT_NE(some.output.find("plan: 3 photos"), std::string::npos) << some.output;
+  EXPECT_NE(some.output.find("skipped 0001.png: it is an identical copy of 0001 copy.png"), std::string::npos)
+      << some.output;
+
+  const fs::path copies = dir.Path() / "copies";
+  fs::create_directories(copies);
+  for (const char* name : {"a.png", "b.png", "c.png", "d.png"}) fs::copy_file(kSmallImages / "0000.png", copies / name);
+  const CliResult alone = RunParallax(Reconstruct(copies, dir.Path() / "ws2"));
+  ExpectFailure(alone, 2, "1 readable image(s)");
+  EXPECT_NE(alone.output.find("d.png is an identical copy of a.png"), std::string::npos) << alone.output;
+}
+
 TEST(ReconstructCli, UnwritableWorkspaceExitsTwo) {
   const TempDir dir;
   std::ofstream(dir.Path() / "a_file") << "x";
