@@ -11,6 +11,7 @@
 #include "mvs/mvs.h"
 #include "pipeline/dense_stages.h"
 #include "pipeline/stage_graph.h"
+#include "reproject/distorted_target.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -43,7 +44,7 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
                           RenderSummary& summary) {
   std::set<std::string> missing;
   for (const NamedCamera& target : targets) {
-    for (int index : SelectSources(library.Cameras(), target.camera, selection)) {
+    for (int index : SelectSources(library.Cameras(), RenderedCamera(target.camera), selection)) {
       const std::string& name = library.Names()[static_cast<size_t>(index)];
       if (!fs::exists(workspace.Depth(name))) missing.insert(name);
     }

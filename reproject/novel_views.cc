@@ -11,6 +11,7 @@
 
 #include "core/depth_map.h"
 #include "core/error.h"
+#include "reproject/distorted_target.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
@@ -293,6 +294,15 @@ RgbGain ExposureOfSources(const SourceLibrary& library, const std::vector<int>& 
 void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
                      const SourceSelectionOptions& selection, Renderer& renderer, NovelView* view) {
   using Clock = std::chrono::steady_clock;
+  const Camera& camera = target.camera.camera;
+  if (camera.HasDistortion()) {
+    const NamedCamera pinhole{target.name, RenderedCamera(target.camera)};
+    RenderNovelView(library, pinhole, selection, renderer, view);
+    const auto start = Clock::now();
+    ResampleIntoDistorted(camera, pinhole.camera.camera, &view->result);
+    view->ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    return;
+  }
   const auto select_start = Clock::now();
   std::vector<int> chosen = SelectSources(library.Cameras(), target.camera, selection);
   const auto select_end = Clock::now();

@@ -6,7 +6,8 @@
 //    z forward; pixel centres lie at integer + 0.5; depth is z-depth, 0 = no value.
 //  - Cameras are pinhole (PINHOLE or SIMPLE_PINHOLE, or a distortion model whose distortion
 //    parameters are all 0): workspace images are undistorted. Anything else throws
-//    std::invalid_argument.
+//    std::invalid_argument; RenderNovelView renders a target with distortion in a pinhole
+//    camera and resamples it (distorted_target.h).
 //  - Colors are linear-light float RGB in memory; callers convert sRGB with core/image.h.
 //  - No NaN or Inf ever leaves a function: divisions are guarded and results checked finite.
 #include <cstdint>

@@ -1,15 +1,19 @@
 // `parallax render` through the real executable: outputs, the leave-out of depth estimation,
 // and its error paths.
 #include <fstream>
+#include <tuple>
 #include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
 #include "core/image.h"
+#include "core/image_metrics.h"
 #include "core/workspace.h"
 #include "geometry/obj.h"
 #include "tests/cli_runner.h"
@@ -127,6 +131,73 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_EQ(filled.rfind("filled ", 0), 0u) << filled;
   EXPECT_GT(std::stod(filled.substr(7)), 0.5) << filled;  // Percent of the sources' pixels.
   EXPECT_LT(HoleRatioSum(dir.Path() / "out_mesh"), HoleRatioSum(dir.Path() / "out"));
+}
+
+// `image` (a photo of the small scene's PINHOLE 280 280 160 120 camera) as a camera with the
+// OpenCV distortion coefficients `distortion` would have seen it: each distorted pixel takes
+// the photo at its undistorted position (OpenCV's model, not parallax's). `inside` marks the
+// pixels whose position lies in the photo.
+Image DistortedLike(const Image& image, const std::vector<double>& distortion, std::vector<uint8_t>* inside) {
+  const int width = image.Width(), height = image.Height();
+  const cv::Matx33d k(280, 0, 160, 0, 280, 120, 0, 0, 1);
+  std::vector<cv::Point2d> pixels;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) pixels.emplace_back(x + 0.5, y + 0.5);
+  }
+  std::vector<cv::Point2d> undistorted;
+  cv::undistortPoints(pixels, undistorted, k, distortion, cv::noArray(), k,
+                      cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-12));
+  cv::Mat map_x(height, width, CV_32F), map_y(height, width, CV_32F);
+  inside->assign(pixels.size(), 0);
+  for (size_t i = 0; i < pixels.size(); ++i) {
+    map_x.at<float>(static_cast<int>(i)) = static_cast<float>(undistorted[i].x - 0.5);
+    map_y.at<float>(static_cast<int>(i)) = static_cast<float>(undistorted[i].y - 0.5);
+    (*inside)[i] = undistorted[i].x >= 1 && undistorted[i].y >= 1 && undistorted[i].x <= width - 1 &&
+                   undistorted[i].y <= height - 1;
+  }
+  const cv::Mat source(height, width, CV_32FC3, const_cast<float*>(image.Pixels().data()));
+  Image out(width, height, 3);
+  cv::Mat target(height, width, CV_32FC3, out.Pixels().data());
+  cv::remap(source, target, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  return out;
+}
+
+TEST(RenderCli, CamerasWithLensDistortionAreRenderedThroughIt) {
+  const TempDir dir;
+  const fs::path out = dir.Path() / "out";
+  ASSERT_EQ(RunParallax("render " + Quote(kSmall.string()) + " --cameras " +
+                        Quote((kSmall / "novel" / "sparse").string()) + " --out " + Quote((out / "pinhole").string()))
+                .exit_code,
+            0);
+  const Image truth = ReadImage(kSmall / "novel" / "images" / "novel_0000.png");
+  const Image pinhole = ReadImage(out / "pinhole" / "novel_0000.png");
+  const double pinhole_psnr = Psnr(pinhole, truth);
+  // About 10 px of distortion at the corners.
+  const std::vector<std::tuple<std::string, std::string, std::vector<double>>> models = {
+      {"SIMPLE_RADIAL", "280 160 120 0.1", {0.1, 0, 0, 0}},
+      {"RADIAL", "280 160 120 0.08 0.05", {0.08, 0.05, 0, 0}},
+      {"OPENCV", "280 280 160 120 0.08 0.02 0.002 -0.003", {0.08, 0.02, 0.002, -0.003}}};
+  for (const auto& [model, params, distortion] : models) {
+    SCOPED_TRACE(model);
+    const fs::path cameras = dir.Path() / model;
+    fs::copy(kSmall / "novel" / "sparse", cameras);
+    std::ofstream(cameras / "cameras.txt") << "1 " << model << " 320 240 " << params << "\n";
+    const CliResult result = RunParallax("render " + Quote(kSmall.string()) + " --cameras " +
+                                         Quote(cameras.string()) + " --out " + Quote((out / model).string()));
+    ASSERT_EQ(result.exit_code, 0) << result.output;
+    std::vector<uint8_t> inside;
+    const Image distorted_truth = DistortedLike(truth, distortion, &inside);
+    const double psnr = Psnr(ReadImage(out / model / "novel_0000.png"), distorted_truth, inside);
+    // As close to the distorted photo as the pinhole render is to the photo, and far closer
+    // than the pinhole render itself (what ignoring the distortion would give). Measured:
+    // 38.2 dB for each model, the pinhole render 36.4 dB to the photo and 26.9-28.0 dB to the
+    // distorted photo.
+    EXPECT_GT(psnr, pinhole_psnr - 1.5);
+    EXPECT_GT(psnr, Psnr(pinhole, distorted_truth, inside) + 6);
+    const Image depth = ReadImage(out / model / "novel_0000.depth.exr");
+    EXPECT_EQ(depth.Width(), 320);
+    EXPECT_EQ(depth.Height(), 240);
+  }
 }
 
 TEST(RenderCli, BadInputExitsTwoAndNamesTheProblem) {
