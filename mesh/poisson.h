@@ -19,10 +19,11 @@ struct MeshOptions {
   // Poisson closes the surface everywhere, also where no photo saw anything; a triangle is
   // kept only if each of its corners lies within this many octree cells of a fused point.
   double max_cells_from_data = 2;
-  // COLMAP's density trim (--PoissonMeshing.trim, its default 10): removes the surface where
-  // the samples are sparser than this. Lower than COLMAP's, for clouds fused at the depth
-  // stage's working resolution (docs/mesh.md); the trim above removes what is far from data.
-  double poisson_trim = 7;
+  // COLMAP's density trim (--PoissonMeshing.trim): removes the surface where the samples are
+  // sparser than this, in log2 of the sample density. Its default, 10, suits a cloud fused at
+  // the photos' full size; the mesh stage lowers it by log2 of the share of the photos' pixels
+  // the cloud was fused from (docs/mesh.md).
+  double poisson_trim = 10;
   // The viewer's level of detail: a mesh with more triangles also gets a simplified copy with
   // at most this many (about one per 28 pixels of a 1280x720 view), textured on its own, which
   // the viewer draws when the full mesh would have more triangles than the pixels need.

@@ -146,9 +146,24 @@ Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const
   return stage;
 }
 
-Stage MeshStage(const Workspace& workspace, const std::string& depth_key,
-                const std::string& color_gains_key, Quality quality, const Colmap& colmap,
-                Progress& progress) {
+namespace {
+
+// The mean share of each photo's pixels the depth stage (and so fusion) works at.
+double FusedPixelShare(const Workspace& workspace, const DepthRequest& request) {
+  const MvsOptions options = MvsOptionsOf(request);
+  const SparseModel model = ReadSparseModel(workspace.Sparse());
+  double sum = 0;
+  for (const Camera& camera : model.Cameras()) {
+    const double scale = options.ScaleFor(static_cast<int>(camera.width), static_cast<int>(camera.height));
+    sum += scale * scale;
+  }
+  return model.Cameras().empty() ? 1.0 : sum / static_cast<double>(model.Cameras().size());
+}
+
+}  // namespace
+
+Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
+                const std::string& color_gains_key, const Colmap& colmap, Progress& progress) {
   Stage stage;
   stage.name = "mesh";
   stage.key = Hasher()
@@ -156,12 +171,14 @@ Stage MeshStage(const Workspace& workspace, const std::string& depth_key,
                   .Add(color_gains_key)
                   .Add(kFusionVersion)
                   .Add(kMeshVersion)
-                  .Add(static_cast<uint64_t>(quality))
+                  .Add(static_cast<uint64_t>(request.quality))
                   .Hex();
   stage.outputs = {workspace.MeshSummary()};
-  stage.run = [workspace, quality, &colmap, &progress] {
-    const MeshSummary mesh =
-        MeshWorkspace(workspace.Root(), colmap, MeshOptionsFor(quality), progress);
+  stage.run = [workspace, request, &colmap, &progress] {
+    MeshOptions options = MeshOptionsFor(request.quality);
+    // A cloud fused from fewer pixels is less dense where it is complete.
+    options.poisson_trim += std::log2(FusedPixelShare(workspace, request));
+    const MeshSummary mesh = MeshWorkspace(workspace.Root(), colmap, options, progress);
     WriteFileAtomically(workspace.MeshSummary(), nlohmann::json(mesh).dump(2) + "\n");
   };
   return stage;

@@ -53,9 +53,8 @@ std::string EnsureColorGains(const Workspace& workspace);
 Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
                   const std::string& color_gains_key, Progress& progress);
 
-Stage MeshStage(const Workspace& workspace, const std::string& depth_key,
-                const std::string& color_gains_key, Quality quality, const Colmap& colmap,
-                Progress& progress);
+Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
+                const std::string& color_gains_key, const Colmap& colmap, Progress& progress);
 
 // The key that identifies a workspace's undistorted model: the one its undistort stage
 // completed with, or, for a workspace not made by reconstruct, a hash of its model files.
