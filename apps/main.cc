@@ -7,6 +7,7 @@
 
 #include "apps/commands.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace parallax {
 namespace {
@@ -28,6 +29,7 @@ int PrintError(const char* message, int code) {
 
 int main(int argc, char** argv) {
   using namespace parallax;
+  InstallInterruptHandler();
   CLI::App app(
       "parallax: image-based modeling and reprojection.\n"
       "Photos -> COLMAP cameras -> CPU multi-view stereo depth -> novel views by depth-image "

@@ -7,10 +7,13 @@
 #include <stdexcept>
 
 #include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include "core/interrupt.h"
 
 extern char** environ;
 
@@ -85,13 +88,27 @@ ProcessResult RunProcess(const std::vector<std::string>& argv,
   std::vector<char*> argument_pointers = PointersTo(arguments);
   std::vector<char*> environment_pointers = PointersTo(environment);
 
+  // The child takes SIGINT and SIGTERM as programs do, not blocked as in parallax's threads
+  // (core/interrupt.h).
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t no_signals, interrupts;
+  sigemptyset(&no_signals);
+  sigemptyset(&interrupts);
+  sigaddset(&interrupts, SIGINT);
+  sigaddset(&interrupts, SIGTERM);
+  posix_spawnattr_setsigmask(&attributes, &no_signals);
+  posix_spawnattr_setsigdefault(&attributes, &interrupts);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
   pid_t pid = 0;
-  const int spawn_error = ::posix_spawnp(&pid, arguments[0].c_str(), &actions, nullptr,
+  const int spawn_error = ::posix_spawnp(&pid, arguments[0].c_str(), &actions, &attributes,
                                          argument_pointers.data(), environment_pointers.data());
   posix_spawn_file_actions_destroy(&actions);
+  posix_spawnattr_destroy(&attributes);
   if (spawn_error != 0) {
     throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(spawn_error));
   }
+  const RunningChild running(pid);
   write_end.Close();  // Only the child writes now; EOF arrives when it exits.
 
   std::string pending;

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -33,6 +34,7 @@ void WriteAtomically(const fs::path& path, const std::function<void(const fs::pa
     }
   }
   const fs::path temporary = TemporaryPathFor(path);
+  const TemporaryOutput guard(temporary);
   try {
     write(temporary);
   } catch (...) {

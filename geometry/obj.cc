@@ -13,6 +13,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -115,6 +116,7 @@ void CopyTriangles(const tinyobj::ObjReader& reader, const std::vector<size_t>& 
 
 void WriteTexturedMesh(const fs::path& dir, const TriangleMesh& mesh) {
   const fs::path temporary = dir.string() + ".tmp";
+  const TemporaryOutput guard(temporary);
   fs::remove_all(temporary);
   fs::create_directories(temporary);
   WriteFileAtomically(temporary / "mesh.obj", ObjText(mesh));

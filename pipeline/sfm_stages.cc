@@ -9,12 +9,21 @@
 #include "colmap/database.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/interrupt.h"
 #include "core/hash.h"
 #include "sfm/undistort.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
 namespace {
+
+// A colmap database being written, and the files SQLite keeps beside it: an interrupted run
+// removes them all (core/interrupt.h).
+struct TemporaryDatabase {
+  explicit TemporaryDatabase(const fs::path& path)
+      : file(path), wal(path.string() + "-wal"), shm(path.string() + "-shm"), journal(path.string() + "-journal") {}
+  TemporaryOutput file, wal, shm, journal;
+};
 
 struct QualitySettings {
   int max_image_size;
@@ -199,6 +208,7 @@ Stage FeaturesStage(const SfmContext& sfm) {
     for (const Photo& photo : sfm.photos.photos) list += photo.name + "\n";
     WriteFileAtomically(paths.ImageList(), list);
     const fs::path database = paths.Database().string() + ".tmp";
+    const TemporaryDatabase temporary(database);
     RemoveAll(database);
     std::vector<std::string> arguments = {
         "--database_path", database.string(), "--image_path", sfm.photos_dir.string(),
@@ -234,6 +244,7 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key) {
     const int num_images = static_cast<int>(sfm.photos.photos.size());
     const int overlap = sfm.options.sequential_overlap;
     const fs::path database = paths.Database().string() + ".tmp";
+    const TemporaryDatabase temporary(database);
     fs::copy_file(paths.Database(), database, fs::copy_options::overwrite_existing);
     const std::vector<std::string> common = {
         "--database_path", database.string(), "--SiftMatching.use_gpu", "0",
@@ -287,6 +298,7 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
   stage.outputs = {paths.RawModel()};
   stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, name = stage.name] {
     const fs::path models = paths.Models().string() + ".tmp";
+    const TemporaryOutput temporary(models);
     RemoveAll(models);
     fs::create_directories(models);
     const std::vector<std::string> common = {"--database_path", paths.Database().string(),

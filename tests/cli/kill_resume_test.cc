@@ -3,6 +3,7 @@
 // while it runs, no other process writes the workspace.
 #include <csignal>
 #include <chrono>
+#include <fstream>
 #include <map>
 #include <thread>
 
@@ -132,6 +133,52 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   EXPECT_FALSE(skipped.at("depth"));
   EXPECT_EQ(CountFiles(Workspace(workspace).DepthDir(), ".exr"), 24u);  // Depth + confidence per view.
   ExpectEveryFileComplete(workspace);
+}
+
+// Processes whose command line names `path`.
+size_t ProcessesNaming(const std::string& path) {
+  size_t count = 0;
+  for (const auto& entry : fs::directory_iterator("/proc")) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream file(entry.path() / "cmdline", std::ios::binary);
+    const std::string command_line((std::istreambuf_iterator<char>(file)), {});
+    count += command_line.find(path) != std::string::npos;
+  }
+  return count;
+}
+
+// SIGTERM while colmap extracts features: the run stops at once with 128 + 15, colmap with
+// it, no temporary file is left, and the next run resumes.
+TEST(KillResume, SigtermStopsColmapRemovesTemporariesAndTheRerunResumes) {
+  const TempDir dir;
+  const fs::path workspace = dir.Path() / "ws";
+  const std::string executable = PARALLAX_EXECUTABLE;
+  const std::string photos = kSmallImages.string(), ws = workspace.string();
+  const char* argv[] = {executable.c_str(), "reconstruct", photos.c_str(), ws.c_str(), "--no-depth", nullptr};
+  pid_t pid = 0;
+  ASSERT_EQ(posix_spawn(&pid, executable.c_str(), nullptr, nullptr, const_cast<char* const*>(argv), environ), 0);
+  const fs::path database = Workspace(workspace).Database().string() + ".tmp";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  while (!fs::exists(database) && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(fs::exists(database)) << "colmap never started";
+  const auto sent = std::chrono::steady_clock::now();
+  ::kill(pid, SIGTERM);  // parallax alone, not its process group: it must stop colmap itself.
+  int status = 0;
+  waitpid(pid, &status, 0);
+  EXPECT_LT(std::chrono::steady_clock::now() - sent, std::chrono::seconds(10));
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(ProcessesNaming(ws), 0u) << "colmap outlived the run";
+  for (const auto& entry : fs::recursive_directory_iterator(workspace)) {
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+  ExpectEveryFileComplete(workspace);
+  const CliResult rerun = RunParallax("reconstruct " + Quote(photos) + " " + Quote(ws) + " --no-depth");
+  EXPECT_EQ(rerun.exit_code, 0) << rerun.output;
 }
 
 }  // namespace
