@@ -46,22 +46,6 @@ Camera FusionCamera(const Camera& camera, const FusionOptions& options) {
   return WorkingCamera(camera, WorkingScale(width, height, options.image_scale, options.max_image_size));
 }
 
-// For each pixel of a working_width x working_height grid over a width x height one, the index
-// of the fine pixel its centre falls in: the depth stage's maps were upsampled to the photo's
-// size by nearest neighbour, so these pixels hold its estimates as they were.
-std::vector<size_t> FinePixelsAtCentres(int width, int height, int working_width, int working_height) {
-  std::vector<size_t> fine;
-  fine.reserve(static_cast<size_t>(working_width) * static_cast<size_t>(working_height));
-  for (int y = 0; y < working_height; ++y) {
-    const int fy = std::min(height - 1, static_cast<int>((y + 0.5) * height / working_height));
-    for (int x = 0; x < working_width; ++x) {
-      const int fx = std::min(width - 1, static_cast<int>((x + 0.5) * width / working_width));
-      fine.push_back(static_cast<size_t>(fy) * static_cast<size_t>(width) + static_cast<size_t>(fx));
-    }
-  }
-  return fine;
-}
-
 // `image` resampled to width x height by area averaging (no aliasing).
 Image ResampleArea(const Image& image, int width, int height) {
   if (image.Width() == width && image.Height() == height) return image;
@@ -175,7 +159,8 @@ class FusionViewCache {
     view.world_from_cam = image.cam_from_world.rotation.conjugate().toRotationMatrix();
     const int working_width = static_cast<int>(view.camera.width);
     const int working_height = static_cast<int>(view.camera.height);
-    const std::vector<size_t> fine = FinePixelsAtCentres(width, height, working_width, working_height);
+    // The maps were upsampled by nearest neighbour: these pixels hold the estimates as they were.
+    const std::vector<size_t> fine = PixelsAtCentres(width, height, working_width, working_height);
     const size_t fine_pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
     view.depth = DepthMap(working_width, working_height);
     view.normals = {working_width, working_height, 3, std::vector<float>(3 * fine.size())};

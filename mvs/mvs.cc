@@ -49,21 +49,6 @@ GrayImage ResampleTo(const GrayImage& image, const Camera& camera) {
   return {width, height, std::vector<float>(small.begin<float>(), small.end<float>())};
 }
 
-// Back to the photo's size, nearest: for each pixel of a width x height image (row-major), the
-// index of the low_width x low_height pixel its centre falls in.
-std::vector<size_t> NearestLowResolutionPixels(int low_width, int low_height, int width, int height) {
-  std::vector<size_t> nearest;
-  nearest.reserve(static_cast<size_t>(width) * static_cast<size_t>(height));
-  for (int y = 0; y < height; ++y) {
-    const int ly = std::min(low_height - 1, static_cast<int>((y + 0.5) * low_height / height));
-    for (int x = 0; x < width; ++x) {
-      const int lx = std::min(low_width - 1, static_cast<int>((x + 0.5) * low_width / width));
-      nearest.push_back(static_cast<size_t>(ly) * static_cast<size_t>(low_width) + static_cast<size_t>(lx));
-    }
-  }
-  return nearest;
-}
-
 DepthMap UpsampleNearest(const DepthMap& depth, const std::vector<size_t>& nearest, int width, int height) {
   DepthMap full(width, height);
   for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
@@ -289,7 +274,7 @@ void WriteViewDepth(const Workspace& ws, const Camera& camera, const DepthNormal
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   const bool same_size = low.depth.Width() == width && low.depth.Height() == height;
   const std::vector<size_t> nearest =
-      same_size ? std::vector<size_t>() : NearestLowResolutionPixels(low.depth.Width(), low.depth.Height(), width, height);
+      same_size ? std::vector<size_t>() : PixelsAtCentres(low.depth.Width(), low.depth.Height(), width, height);
   const DepthNormalMap estimate = same_size ? low : UpsampleNearest(low, nearest, width, height);
   if (!same_size) {
     filtered.depth = UpsampleNearest(filtered.depth, nearest, width, height);
