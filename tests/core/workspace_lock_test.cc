@@ -52,9 +52,14 @@ TEST(WorkspaceLock, OneWriterOrManyReaders) {
   EXPECT_NE(Refusal(dir.Path(), LockMode::kShared).find("is being written by render"), std::string::npos);
 }
 
-TEST(WorkspaceLock, AMissingWorkspaceIsNamedAndAReadOnlyOneCanBeRead) {
+TEST(WorkspaceLock, AMissingWorkspaceIsNamed) {
   const TempDir dir;
   EXPECT_NE(Refusal(dir.Path() / "missing", LockMode::kShared).find("does not exist"), std::string::npos);
+  EXPECT_NE(Refusal(dir.Path() / "missing", LockMode::kExclusive).find("does not exist"), std::string::npos);
+}
+
+TEST(WorkspaceLock, AReadOnlyWorkspaceCanBeReadButNotWritten) {
+  const TempDir dir;
   if (::geteuid() == 0) GTEST_SKIP() << "root writes into read-only folders";
   const std::filesystem::path read_only = dir.Path() / "read-only";
   std::filesystem::create_directories(read_only);
