@@ -126,7 +126,7 @@ std::optional<size_t> TripleOffset(const Element& element, const std::string& ty
   return std::nullopt;
 }
 
-void ReadVertices(const std::string& bytes, const Element& element, size_t& offset,
+void ReadVertices(const std::string& bytes, const Element& element, size_t& offset, NonFiniteVertices non_finite,
                   const fs::path& path, TriangleMesh& mesh) {
   if (element.properties.size() < 3 || element.properties[0] != "float x" ||
       element.properties[1] != "float y" || element.properties[2] != "float z") {
@@ -146,7 +146,7 @@ void ReadVertices(const std::string& bytes, const Element& element, size_t& offs
     std::memcpy(mesh.vertices[i].data(), record, 12);
     if (normal) std::memcpy(mesh.normals[i].data(), record + *normal, 12);
     if (color) std::memcpy(mesh.colors[i].data(), record + *color, 3);
-    if (!mesh.vertices[i].allFinite()) {
+    if (!mesh.vertices[i].allFinite() && non_finite == NonFiniteVertices::kRefuse) {
       throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }
   }
@@ -190,7 +190,7 @@ void ReadFaces(const std::string& bytes, const Element& element, size_t& offset,
 
 }  // namespace
 
-TriangleMesh ReadPly(const fs::path& path) {
+TriangleMesh ReadPly(const fs::path& path, NonFiniteVertices non_finite) {
   const std::string bytes = ReadFileBytes(path);
   const Header header = ParseHeader(bytes, path);
   TriangleMesh mesh;
@@ -198,7 +198,7 @@ TriangleMesh ReadPly(const fs::path& path) {
   bool has_vertices = false;
   for (const Element& element : header.elements) {
     if (element.name == "vertex") {
-      ReadVertices(bytes, element, offset, path, mesh);
+      ReadVertices(bytes, element, offset, non_finite, path, mesh);
       has_vertices = true;
     } else if (element.name == "face") {
       if (!has_vertices) throw BadInputError(path.string() + ": faces before vertices");
@@ -209,6 +209,14 @@ TriangleMesh ReadPly(const fs::path& path) {
     }
   }
   if (!has_vertices) throw BadInputError(path.string() + ": no vertex element");
+  if (non_finite == NonFiniteVertices::kDropTheirTriangles) {
+    std::erase_if(mesh.triangles, [&](const Eigen::Vector3i& triangle) {
+      for (int c = 0; c < 3; ++c) {
+        if (!mesh.vertices[static_cast<size_t>(triangle[c])].allFinite()) return true;
+      }
+      return false;
+    });
+  }
   return mesh;
 }
 

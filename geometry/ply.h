@@ -11,8 +11,14 @@
 
 namespace parallax {
 
+// What a NaN or Inf vertex position does: refuse the file, or drop the triangles that use the
+// vertex (colmap's poisson_mesher writes one now and then) and leave the vertex unreferenced.
+enum class NonFiniteVertices { kRefuse, kDropTheirTriangles };
+
 // Throws BadInputError naming the file for anything else (ASCII or big-endian files, a
-// truncated body, faces that are not triangles, indices out of range, NaN or Inf positions).
-TriangleMesh ReadPly(const std::filesystem::path& path);
+// truncated body, faces that are not triangles, indices out of range, NaN or Inf positions
+// unless they are dropped).
+TriangleMesh ReadPly(const std::filesystem::path& path,
+                     NonFiniteVertices non_finite = NonFiniteVertices::kRefuse);
 
 }  // namespace parallax

@@ -71,7 +71,9 @@ float OctreeCell(const std::vector<Eigen::Vector3f>& points, int depth) {
 // Drops triangles with a corner far from the data, and the vertices no triangle uses.
 TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius) {
   std::vector<uint8_t> near(mesh.vertices.size());
-  for (size_t v = 0; v < mesh.vertices.size(); ++v) near[v] = grid.AnyWithin(mesh.vertices[v], radius);
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    near[v] = mesh.vertices[v].allFinite() && grid.AnyWithin(mesh.vertices[v], radius);
+  }
   TriangleMesh trimmed;
   std::vector<int> new_index(mesh.vertices.size(), -1);
   for (const Eigen::Vector3i& triangle : mesh.triangles) {
@@ -150,7 +152,8 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   fs::rename(temporary, poisson);
 
   progress.Update("trim", 0, 1);
-  const TriangleMesh raw = ReadPly(poisson);
+  // colmap's solver now and then writes a NaN vertex: its triangles go, the rest is kept.
+  const TriangleMesh raw = ReadPly(poisson, NonFiniteVertices::kDropTheirTriangles);
   const float cell = OctreeCell(points, options.poisson_depth);
   const float radius = static_cast<float>(options.max_cells_from_data) * cell;
   const TriangleMesh trimmed = Trim(raw, PointGrid(points, radius), radius);

@@ -1,11 +1,14 @@
 #include "geometry/ply.h"
 
+#include <array>
 #include <cstring>
+#include <limits>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -54,6 +57,30 @@ TEST(Ply, ReadsNormalsAndColorsWhereTheCloudHasThem) {
   EXPECT_EQ(bare.vertices[2], Eigen::Vector3f(-1, 0, 1));
   EXPECT_TRUE(bare.normals.empty());
   EXPECT_TRUE(bare.colors.empty());
+}
+
+// Four vertices, the third NaN, and two triangles: (0, 1, 3) and (1, 2, 3), which uses it.
+std::string MeshWithANanVertex() {
+  std::string text =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float vertices[4][3] = {{0, 0, 0}, {1, 0, 0}, {nan, 0, 0}, {0, 1, 0}};
+  text.append(reinterpret_cast<const char*>(vertices), sizeof(vertices));
+  for (const std::array<int, 3>& face : {std::array<int, 3>{0, 1, 3}, std::array<int, 3>{1, 2, 3}}) {
+    text.push_back(3);
+    text.append(reinterpret_cast<const char*>(face.data()), 3 * sizeof(int));
+  }
+  return text;
+}
+
+TEST(Ply, ANanVertexIsRefusedOrItsTrianglesDropped) {
+  const TempDir dir;
+  WriteFileAtomically(dir.Path() / "mesh.ply", MeshWithANanVertex());
+  EXPECT_THROW(ReadPly(dir.Path() / "mesh.ply"), BadInputError);
+  const TriangleMesh kept = ReadPly(dir.Path() / "mesh.ply", NonFiniteVertices::kDropTheirTriangles);
+  ASSERT_EQ(kept.triangles.size(), 1u);
+  EXPECT_EQ(kept.triangles[0], Eigen::Vector3i(0, 1, 3));
 }
 
 }  // namespace
