@@ -1,12 +1,13 @@
 #pragma once
-// Reads what parallax needs from a COLMAP database (SQLite): which id COLMAP gave each image.
-// COLMAP's multi-threaded feature extractor assigns ids in the order images finish, not in
+// Reads what parallax needs from a COLMAP database (SQLite): which id COLMAP gave each image
+// (COLMAP's multi-threaded feature extractor assigns ids in the order images finish, not in
 // name order, so a model that must match the database (point_triangulator) takes its ids
-// from here.
+// from here), and how each matched pair was verified (to say why mapping could not start).
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace parallax {
 
@@ -17,5 +18,23 @@ struct DatabaseImage {
 
 // Image name -> ids. Throws BadInputError naming the file if it cannot be read.
 std::map<std::string, DatabaseImage> ReadDatabaseImages(const std::filesystem::path& database);
+
+// COLMAP's TwoViewGeometry::ConfigurationType: which model explained a pair's matches best.
+enum class PairGeometry {
+  kUndefined = 0, kDegenerate = 1, kCalibrated = 2, kUncalibrated = 3, kPlanar = 4,
+  kPanoramic = 5, kPlanarOrPanoramic = 6, kWatermark = 7, kMultiple = 8,
+};
+
+// A pair of photos that passed geometric verification, as the matcher stored it.
+struct VerifiedPair {
+  std::string first;
+  std::string second;
+  int inliers = 0;
+  PairGeometry geometry = PairGeometry::kUndefined;
+};
+
+// Every verified pair, in the database's order. Throws BadInputError naming the file if it
+// cannot be read.
+std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database);
 
 }  // namespace parallax

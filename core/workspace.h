@@ -39,6 +39,8 @@ class Workspace {
   std::filesystem::path Sfm() const { return root_ / "sfm"; }
   std::filesystem::path Database() const { return Sfm() / "database.db"; }
   std::filesystem::path ImageList() const { return Sfm() / "image_list.txt"; }
+  // The photos as COLMAP reads them, when some had to be converted (sfm/photo_conversion.h).
+  std::filesystem::path ReadablePhotos() const { return Sfm() / "photos"; }
   std::filesystem::path KnownModel() const { return Sfm() / "known"; }
   std::filesystem::path Models() const { return Sfm() / "models"; }
   std::filesystem::path RawModel() const { return Sfm() / "sparse"; }

@@ -263,16 +263,22 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   }
   const int num_images = summary.images_found;
   const bool sequential = UseSequentialMatcher(options, num_images);
-  const SfmContext sfm{photos_dir, photos, known ? &*known : nullptr, options, colmap,
-                       Workspace(workspace), ChooseCameraSetup(photos, options, known ? &*known : nullptr),
+  const Workspace paths(workspace);
+  const SfmContext sfm{ReadablePhotosDir(photos_dir, photos, paths), photos, known ? &*known : nullptr, options, colmap,
+                       paths, ChooseCameraSetup(photos, options, known ? &*known : nullptr),
                        sequential, progress};
   summary.camera_model = std::string(CameraModelName(sfm.camera.model)) +
                          (sfm.camera.single_camera ? ", one shared camera" : ", one camera per image") +
                          (sfm.camera.fixed_intrinsics ? ", intrinsics fixed" : "");
   summary.matcher = DescribeMatcher(options, num_images, sequential);
 
+  const std::string conversions = DescribeConversions(photos, paths);
+  if (!conversions.empty()) summary.notes.push_back(conversions);
+
   StageGraph graph(sfm.workspace, options.dry_run);
-  const Stage features = FeaturesStage(sfm);
+  const Stage converted = PhotosStage(photos_dir, photos, paths, progress);
+  graph.Run(converted);
+  const Stage features = FeaturesStage(sfm, converted.key);
   graph.Run(features);
   const Stage matches = MatchesStage(sfm, features.key);
   graph.Run(matches);

@@ -6,11 +6,14 @@
 #include <map>
 #include <sstream>
 
+#include <tbb/parallel_for.h>
+
 #include "colmap/database.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/hash.h"
+#include "sfm/photo_conversion.h"
 #include "sfm/undistort.h"
 
 namespace parallax {
@@ -188,12 +191,79 @@ std::string DescribeMatcher(const ReconstructOptions& options, int num_images, b
   return matcher;
 }
 
-Stage FeaturesStage(const SfmContext& sfm) {
+fs::path ReadablePhotosDir(const fs::path& photos_dir, const PhotoSet& photos,
+                           const Workspace& workspace) {
+  return photos.NeedsConversion() ? workspace.ReadablePhotos() : photos_dir;
+}
+
+Stage PhotosStage(const fs::path& photos_dir, const PhotoSet& photos, const Workspace& workspace,
+                  Progress& progress) {
+  Stage stage;
+  stage.name = "photos";
+  stage.key = Hasher().Add(photos.ContentHash()).Add("photos-1").Hex();
+  if (!photos.NeedsConversion()) {
+    stage.not_needed = "every photo is an 8-bit RGB JPEG or PNG, upright: colmap reads them as "
+                       "they are (nothing converted)";
+    stage.run = [] {};
+    return stage;
+  }
+  stage.outputs = {workspace.ReadablePhotos()};
+  stage.run = [photos_dir, &photos, workspace, &progress] {
+    const fs::path output = workspace.ReadablePhotos().string() + ".tmp";
+    const TemporaryOutput temporary(output);
+    RemoveAll(output);
+    fs::create_directories(output);
+    const int total = static_cast<int>(photos.photos.size());
+    int done = 0;
+    progress.Update("photos", 0, total);
+    // Conversions in parallel, progress from this thread only (core/progress.h).
+    for (int start = 0; start < total; start += 16) {
+      const int end = std::min(total, start + 16);
+      tbb::parallel_for(start, end, [&](int i) {
+        const Photo& photo = photos.photos[static_cast<size_t>(i)];
+        const fs::path from = photos_dir / photo.name;
+        const fs::path to = output / photo.name;
+        if (!photo.conversion.empty()) return WriteReadablePhoto(from, to);
+        std::error_code error;
+        fs::create_hard_link(from, to, error);
+        if (error) fs::copy_file(from, to);
+      });
+      done = end;
+      progress.Update("photos", done, total);
+    }
+    Replace(output, workspace.ReadablePhotos());
+  };
+  return stage;
+}
+
+std::string DescribeConversions(const PhotoSet& photos, const Workspace& workspace) {
+  std::map<std::string, int> count_by_reason;
+  int converted = 0;
+  for (const Photo& photo : photos.photos) {
+    if (photo.conversion.empty()) continue;
+    ++converted;
+    ++count_by_reason[photo.conversion];
+  }
+  if (converted == 0) return "";
+  std::string note = std::to_string(converted) + " photo(s) converted to 8-bit RGB, upright, in " +
+                     workspace.ReadablePhotos().string() + " for colmap (";
+  bool first = true;
+  for (const auto& [reason, count] : count_by_reason) {
+    note += (first ? "" : "; ") + std::to_string(count) + " " + reason;
+    first = false;
+  }
+  return note + ")";
+}
+
+Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key) {
   const QualitySettings quality = SettingsFor(sfm.options.quality);
   const Workspace& paths = sfm.workspace;
   Stage stage;
   stage.name = "features";
-  stage.key = Hasher()
+  Hasher hasher;
+  // Without conversions the photos stage changes nothing COLMAP reads (and keeps old keys).
+  if (sfm.photos.NeedsConversion()) hasher.Add(photos_key);
+  stage.key = hasher
                   .Add(sfm.photos.ContentHash())
                   .Add(CameraModelName(sfm.camera.model))
                   .Add(sfm.camera.params)

@@ -30,9 +30,22 @@ struct CameraSetup {
 CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
                               const SparseModel* known);
 
+// The folder COLMAP and the undistortion read the photos from: the user's, or the
+// workspace's copy with the converted photos when some need it (PhotosStage).
+std::filesystem::path ReadablePhotosDir(const std::filesystem::path& photos_dir,
+                                        const PhotoSet& photos, const Workspace& workspace);
+
+// Writes the workspace's readable copy of the photos: each photo that needs it converted,
+// the others linked (or copied where links cannot be made). Not needed, and skipped, when
+// every photo is readable as it is.
+Stage PhotosStage(const std::filesystem::path& photos_dir, const PhotoSet& photos,
+                  const Workspace& workspace, Progress& progress);
+// The sentence report.json notes for the conversions, or "" when there were none.
+std::string DescribeConversions(const PhotoSet& photos, const Workspace& workspace);
+
 // What every SfM stage reads.
 struct SfmContext {
-  std::filesystem::path photos_dir;
+  std::filesystem::path photos_dir;  // ReadablePhotosDir.
   const PhotoSet& photos;
   const SparseModel* known;  // --known-cameras, or null.
   const ReconstructOptions& options;
@@ -47,7 +60,8 @@ struct SfmContext {
 bool UseSequentialMatcher(const ReconstructOptions& options, int num_images);
 std::string DescribeMatcher(const ReconstructOptions& options, int num_images, bool sequential);
 
-Stage FeaturesStage(const SfmContext& sfm);
+// `photos_key` is PhotosStage's key.
+Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key);
 Stage MatchesStage(const SfmContext& sfm, const std::string& features_key);
 // Notes the mapper's decisions (a principal-point refinement kept or rejected) in `notes`.
 Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "sfm/photo_conversion.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -17,6 +18,29 @@ namespace {
 
 // COLMAP's default focal length when nothing better is known.
 constexpr double kDefaultFocalFactor = 1.2;
+
+// The formats photos are taken in, all of which the conversion can write 8-bit.
+bool IsPhotoFormat(const std::string& format) {
+  return format == "jpeg" || format == "png" || format == "tiff" || format == "bmp";
+}
+
+// Why COLMAP (through FreeImage) cannot be trusted to read the file as it is: it reads
+// 8-bit JPEG and PNG, but not 16-bit TIFF; it ignores EXIF orientation; the depth stage wants
+// three channels. Empty when the file is fine as it is.
+std::string ConversionNeeded(const OIIO::ImageSpec& spec, const std::string& format,
+                             const fs::path& path, const std::string& named_format) {
+  std::vector<std::string> reasons;
+  if (format != named_format) reasons.push_back("a " + format + " file named " + path.extension().string());
+  if (format == "tiff" || format == "bmp") reasons.push_back(format);
+  if (spec.format != OIIO::TypeDesc::UINT8) reasons.push_back(std::string(spec.format.c_str()));
+  if (spec.nchannels < 3) reasons.push_back("grayscale");
+  if (spec.nchannels == 2 || spec.nchannels == 4) reasons.push_back("alpha channel");
+  const int orientation = spec.get_int_attribute("Orientation", 1);
+  if (orientation != 1) reasons.push_back("EXIF orientation " + std::to_string(orientation));
+  std::string text;
+  for (const std::string& reason : reasons) text += (text.empty() ? "" : ", ") + reason;
+  return text;
+}
 
 // Decodes the whole file: a truncated image often has an intact header.
 std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
@@ -28,11 +52,20 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   }
   if (bytes.empty()) return "is empty (0 bytes)";
   photo.content_hash = Hasher().Add(bytes).Value();
-  auto input = OIIO::ImageInput::open(path.string());
+  std::string error;
+  const auto input = OpenPhoto(path, error);
   if (!input) return "is not an image OpenImageIO can read";
   const OIIO::ImageSpec& spec = input->spec();
-  photo.width = spec.width;
-  photo.height = spec.height;
+  const std::string format = input->format_name();
+  if (!IsPhotoFormat(format)) return "is a " + format + " image, not a photo format (JPEG, PNG, TIFF or BMP)";
+  const auto named = OIIO::ImageOutput::create(path.filename().string());
+  if (!named || !IsPhotoFormat(named->format_name())) {
+    return "is a " + format + " image without a photo file extension (.jpg, .png, .tif or .bmp)";
+  }
+  photo.conversion = ConversionNeeded(spec, format, path, named->format_name());
+  const bool turned = spec.get_int_attribute("Orientation", 1) >= 5;  // 90 or 270 degrees.
+  photo.width = turned ? spec.height : spec.width;
+  photo.height = turned ? spec.width : spec.height;
   if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
   const double megapixels = static_cast<double>(spec.width) * static_cast<double>(spec.height) / 1e6;
   if (megapixels > kMaxPhotoMegapixels) {
@@ -65,6 +98,11 @@ bool PhotoSet::SharesOneCamera() const {
 
 double PhotoSet::FocalPrior(const Photo& photo) const {
   return photo.exif_focal_px.value_or(kDefaultFocalFactor * std::max(photo.width, photo.height));
+}
+
+bool PhotoSet::NeedsConversion() const {
+  return std::any_of(photos.begin(), photos.end(),
+                     [](const Photo& photo) { return !photo.conversion.empty(); });
 }
 
 uint64_t PhotoSet::ContentHash() const {

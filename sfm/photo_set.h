@@ -15,6 +15,9 @@ struct Photo {
   int height = 0;
   std::optional<double> exif_focal_px;  // From the 35 mm-equivalent focal length, if present.
   uint64_t content_hash = 0;
+  // Why COLMAP cannot read the file as it is ("16-bit", "grayscale", ...), so that it is
+  // converted (sfm/photo_conversion.h); empty: the file is used as it is.
+  std::string conversion;
 };
 
 struct SkippedFile {
@@ -34,6 +37,8 @@ struct PhotoSet {
   double FocalPrior(const Photo& photo) const;
   // Hash of every name and content: changes when any photo changes.
   uint64_t ContentHash() const;
+  // True when any photo must be converted before COLMAP reads it.
+  bool NeedsConversion() const;
 };
 
 // Photos larger than this are refused from their header, before anything is decoded: no
@@ -42,8 +47,9 @@ struct PhotoSet {
 constexpr double kMaxPhotoMegapixels = 128;
 
 // Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.
-// Unreadable, corrupt or non-image files, images over kMaxPhotoMegapixels and identical
-// copies of an earlier photo (by name) are skipped with their reason. Throws BadInputError
+// Unreadable, corrupt or non-image files, formats other than JPEG, PNG, TIFF and BMP, images
+// over kMaxPhotoMegapixels and identical copies of an earlier photo (by name) are skipped
+// with their reason. Sizes are those of the photo turned upright (EXIF orientation). Throws BadInputError
 // if the folder does not exist, is not a folder, or holds fewer than 2 readable images (the
 // message lists the skipped files).
 PhotoSet ScanPhotos(const std::filesystem::path& dir);

@@ -1,2 +1,3 @@
 # Tests over ~30 s get the `slow` label besides their module's, for `ctest -LE slow`.
 set_tests_properties(${bench_test_TESTS} PROPERTIES LABELS "bench;slow")
+set_tests_properties(ReconstructCli.PhotosInEveryFormACameraWritesAreReconstructed PROPERTIES LABELS "cli;slow")
