@@ -143,6 +143,43 @@ std::vector<fs::path> ModelDirs(const Workspace& paths) {
   return dirs;
 }
 
+// Why the mapper found no pair of photos to start from, where the verified matches show it: no
+// pair at all, or only pairs one homography explains (photos from one spot, near-identical
+// copies). "" when the matches do not explain it.
+std::string NoInitialPairReason(const fs::path& database, int num_images) {
+  const std::vector<VerifiedPair> pairs = ReadVerifiedPairs(database);
+  if (pairs.empty()) {
+    return "the photos share no features: no two of the " + std::to_string(num_images) +
+           " photos have enough matching features to pass geometric verification (different "
+           "scenes, too little texture or too little overlap)";
+  }
+  const bool no_parallax = std::all_of(pairs.begin(), pairs.end(), [](const VerifiedPair& pair) {
+    return pair.geometry == PairGeometry::kPlanarOrPanoramic || pair.geometry == PairGeometry::kPanoramic;
+  });
+  if (!no_parallax) return "";
+  const VerifiedPair& best = *std::max_element(
+      pairs.begin(), pairs.end(), [](const VerifiedPair& a, const VerifiedPair& b) { return a.inliers < b.inliers; });
+  return "the photos have no parallax: each of the " + std::to_string(pairs.size()) +
+         " matched pairs is explained by a homography (the best, " + best.first + " and " + best.second +
+         ", by " + std::to_string(best.inliers) + " matches), as for near-identical photos or photos "
+         "taken from one spot; take the photos from positions a step or more apart";
+}
+
+// Runs the mapper; where it fails for want of a pair to start from and the matches say why,
+// that is bad input (exit 2) rather than a tool failure.
+void RunMapper(const SfmContext& sfm, const std::vector<std::string>& arguments, const std::string& name,
+               int num_images) {
+  const Workspace& paths = sfm.workspace;
+  try {
+    sfm.colmap.Run("mapper", arguments, paths.Log(name), name, num_images, sfm.progress);
+  } catch (const ToolError&) {
+    const std::string reason = NoInitialPairReason(paths.Database(), num_images);
+    if (reason.empty()) throw;
+    throw BadInputError("COLMAP could not reconstruct these photos: " + reason + "; see " +
+                        paths.Log(name).string());
+  }
+}
+
 // The model with the most registered images (the first of equals).
 SparseModel LargestModel(const std::vector<fs::path>& dirs) {
   SparseModel best;
@@ -393,7 +430,7 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       if (sfm.camera.fixed_intrinsics) {
         arguments.insert(arguments.end(), fixed_intrinsics.begin(), fixed_intrinsics.end());
       }
-      sfm.colmap.Run("mapper", arguments, paths.Log(name), name, num_images, sfm.progress);
+      RunMapper(sfm, arguments, name, num_images);
     }
     Replace(models, paths.Models());
     WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);

@@ -1,5 +1,6 @@
 // Every error path of `parallax reconstruct`, through the real executable: exit code and
-// message. Input is validated before colmap starts, so these run in well under a second each.
+// message. Input is validated before colmap starts, so most run in well under a second each;
+// those that need colmap's verdict on the photos run it on a few small ones.
 #include <fstream>
 
 #include <OpenImageIO/imagebuf.h>
@@ -17,6 +18,7 @@ namespace {
 namespace fs = std::filesystem;
 
 const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
+const fs::path kCourtyardImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "courtyard" / "images";
 
 void ExpectFailure(const CliResult& result, int exit_code, const std::string& expected) {
   EXPECT_EQ(result.exit_code, exit_code) << result.output;
@@ -139,7 +141,7 @@ TEST(ReconstructCli, IdenticalCopiesAreSkippedAndCopiesAloneExitTwo) {
 // 16-bit TIFFs fail outright), and ignores EXIF orientation. (The small scene is too fragile
 // for this: re-encoding alone makes its mapper fail on most runs.)
 TEST(ReconstructCli, PhotosInEveryFormACameraWritesAreReconstructed) {
-  const fs::path courtyard = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "courtyard" / "images";
+  const fs::path& courtyard = kCourtyardImages;
   const TempDir dir;
   const fs::path photos = dir.Path() / "Fotos – Innenhof";
   fs::create_directories(photos);
@@ -198,6 +200,35 @@ TEST(ReconstructCli, PhotosInEveryFormACameraWritesAreReconstructed) {
   // A second run converts nothing again.
   const CliResult again = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast --dry-run"));
   EXPECT_NE(again.output.find("photos       skip"), std::string::npos) << again.output;
+}
+
+// One photo re-encoded, brightened and blurred: copies no hash catches, with no baseline.
+TEST(ReconstructCli, NearIdenticalPhotosExitTwoSayingTheyHaveNoParallax) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "burst";
+  fs::create_directories(photos);
+  const OIIO::ImageBuf photo((kCourtyardImages / "0000.png").string());
+  ASSERT_TRUE(photo.write((photos / "a.png").string()));
+  ASSERT_TRUE(photo.write((photos / "b.jpg").string()));
+  ASSERT_TRUE(OIIO::ImageBufAlgo::mul(photo, 1.05f).write((photos / "c.png").string()));
+  const OIIO::ImageBuf kernel = OIIO::ImageBufAlgo::make_kernel("gaussian", 3, 3);
+  ASSERT_TRUE(OIIO::ImageBufAlgo::convolve(photo, kernel).write((photos / "d.png").string()));
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws", "--no-depth"));
+  ExpectFailure(result, 2, "the photos have no parallax: each of the 6 matched pairs is explained by a homography");
+  EXPECT_NE(result.output.find("logs/mapper.log"), std::string::npos) << result.output;
+}
+
+TEST(ReconstructCli, PhotosThatShareNoFeaturesExitTwoSayingSo) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "unrelated";
+  fs::create_directories(photos);
+  for (int seed = 1; seed <= 3; ++seed) {
+    OIIO::ImageBuf noise(OIIO::ImageSpec(320, 240, 3, OIIO::TypeDesc::UINT8));
+    ASSERT_TRUE(OIIO::ImageBufAlgo::noise(noise, "uniform", 0.0f, 1.0f, false, seed));
+    ASSERT_TRUE(noise.write((photos / ("noise" + std::to_string(seed) + ".png")).string()));
+  }
+  ExpectFailure(RunParallax(Reconstruct(photos, dir.Path() / "ws", "--no-depth")), 2,
+                "the photos share no features: no two of the 3 photos have enough matching features");
 }
 
 TEST(ReconstructCli, UnwritableWorkspaceExitsTwo) {
