@@ -4,6 +4,7 @@
 #include <fstream>
 #include <regex>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "colmap/subprocess.h"
 
@@ -68,6 +69,11 @@ void Colmap::Run(const std::string& command, const std::vector<std::string>& arg
       });
   log.flush();
   if (result.exit_code != 0) {
+    // A full disk is the user's to fix, not colmap's failure; its log may not even say so.
+    const std::string disk_full = DiskFullReason(log_path.parent_path());
+    if (!disk_full.empty()) {
+      throw BadInputError("colmap " + command + " could not write its output: " + disk_full);
+    }
     std::string message = "colmap " + command + " failed with exit status " +
                           std::to_string(result.exit_code) + "; last lines of its log:\n";
     for (const std::string& line : last_lines) message += "  | " + line + "\n";

@@ -3,6 +3,10 @@
 #include <fstream>
 #include <string>
 #include <system_error>
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "core/error.h"
@@ -38,7 +42,10 @@ void WriteAtomically(const fs::path& path, const std::function<void(const fs::pa
   try {
     write(temporary);
   } catch (...) {
+    // Checked before the partial file is removed, which frees its space.
+    const std::string disk_full = DiskFullReason(path.parent_path());
     fs::remove(temporary, error);
+    if (!disk_full.empty()) throw BadInputError("cannot write " + path.string() + ": " + disk_full);
     throw;
   }
   fs::rename(temporary, path, error);
@@ -50,11 +57,35 @@ void WriteAtomically(const fs::path& path, const std::function<void(const fs::pa
 
 void WriteFileAtomically(const fs::path& path, std::string_view bytes) {
   WriteAtomically(path, [&](const fs::path& temporary) {
-    std::ofstream file(temporary, std::ios::binary);
-    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    file.close();
-    if (!file) throw BadInputError("cannot write " + path.string());
+    // POSIX calls rather than a stream: their errno names the problem ("No space left on
+    // device"), which a stream does not promise to keep.
+    const auto fail = [&] { throw BadInputError("cannot write " + path.string() + ": " + std::strerror(errno)); };
+    const int file = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (file < 0) fail();
+    size_t written = 0;
+    while (written < bytes.size()) {
+      const ssize_t count = ::write(file, bytes.data() + written, bytes.size() - written);
+      if (count < 0 && errno == EINTR) continue;
+      if (count < 0) {
+        const int error = errno;
+        ::close(file);
+        errno = error;
+        fail();
+      }
+      written += static_cast<size_t>(count);
+    }
+    if (::close(file) != 0) fail();
   });
+}
+
+std::string DiskFullReason(const fs::path& path) {
+  struct statvfs disk{};
+  const fs::path existing = path.empty() ? fs::path(".") : path;
+  if (::statvfs(existing.c_str(), &disk) != 0) return "";
+  const double free_bytes = static_cast<double>(disk.f_bavail) * static_cast<double>(disk.f_frsize);
+  if (free_bytes >= 1024.0 * 1024.0) return "";
+  return "No space left on device (" + std::to_string(static_cast<long long>(free_bytes / 1024)) +
+         " KiB free on the file system of " + existing.string() + ")";
 }
 
 std::string ReadFileBytes(const fs::path& path) {

@@ -10,12 +10,17 @@ namespace parallax {
 // Calls `write(temporary_path)`, then renames the temporary file to `path`. Creates the parent
 // folder. If `write` throws, the temporary file is removed and the exception propagates; an
 // existing file at `path` is left untouched. Throws BadInputError if the folder is not
-// writable.
+// writable, or, naming `path` and DiskFullReason, if `write` failed on a full disk.
 void WriteAtomically(const std::filesystem::path& path,
                      const std::function<void(const std::filesystem::path&)>& write);
 
 // Writes `bytes` to `path` atomically.
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+
+// "No space left on device (N KiB free on the file system of `path`)" when that file system
+// has under 1 MiB left, else "": what a failed write by a library or a tool (whose own
+// message may name only a temporary file, or none) most likely ran into.
+std::string DiskFullReason(const std::filesystem::path& path);
 
 // Whole file as bytes; throws BadInputError naming the file if it cannot be read.
 std::string ReadFileBytes(const std::filesystem::path& path);

@@ -181,5 +181,64 @@ TEST(KillResume, SigtermStopsColmapRemovesTemporariesAndTheRerunResumes) {
   EXPECT_EQ(rerun.exit_code, 0) << rerun.output;
 }
 
+// A small file system of its own for the workspace (tmpfs, so root only), unmounted at the end.
+class SmallDisk {
+ public:
+  explicit SmallDisk(const fs::path& where) : where_(where) {
+    fs::create_directories(where);
+    mounted_ = ::geteuid() == 0 &&
+               std::system(("mount -t tmpfs -o size=64m tmpfs '" + where.string() + "' 2>/dev/null").c_str()) == 0;
+  }
+  ~SmallDisk() {
+    if (mounted_) (void)std::system(("umount '" + where_.string() + "'").c_str());
+  }
+  bool Mounted() const { return mounted_; }
+  // Takes all but `leave_kib` of the free space.
+  void Fill(int64_t leave_kib) {
+    const auto free_kib = static_cast<int64_t>(fs::space(where_).available / 1024);
+    std::ofstream filler(where_ / "filler", std::ios::binary);
+    const std::string block(1024, '\0');
+    for (int64_t i = 0; i < free_kib - leave_kib; ++i) filler.write(block.data(), 1024);
+  }
+  void Empty() { fs::remove(where_ / "filler"); }
+
+ private:
+  fs::path where_;
+  bool mounted_ = false;
+};
+
+// A full disk in colmap's stage and in parallax's own: exit 2 naming the file and the cause,
+// nothing earlier lost, and once there is room the run resumes where it stopped.
+TEST(KillResume, AFullDiskExitsTwoNamingThePathAndTheRerunResumes) {
+  const TempDir dir;
+  SmallDisk room(dir.Path() / "disk");
+  if (!room.Mounted()) GTEST_SKIP() << "needs root to mount a small tmpfs";
+  const fs::path workspace = dir.Path() / "disk" / "ws";
+  const std::string reconstruct = "reconstruct " + Quote(kSmallImages.string()) + " " + Quote(workspace.string());
+
+  room.Fill(100);
+  const CliResult features = RunParallax(reconstruct + " --no-depth");
+  EXPECT_EQ(features.exit_code, 2) << features.output;
+  EXPECT_NE(features.output.find("colmap feature_extractor could not write its output: No space left on device"),
+            std::string::npos)
+      << features.output;
+  room.Empty();
+  ASSERT_EQ(RunParallax(reconstruct + " --no-depth").exit_code, 0);
+
+  room.Fill(300);
+  const CliResult depth = RunParallax(reconstruct);
+  EXPECT_EQ(depth.exit_code, 2) << depth.output;
+  EXPECT_NE(depth.output.find("cannot write " + (workspace / "stereo").string()), std::string::npos) << depth.output;
+  EXPECT_NE(depth.output.find("No space left on device"), std::string::npos) << depth.output;
+  ExpectEveryFileComplete(workspace);
+  room.Empty();
+  const CliResult resumed = RunParallax(reconstruct);
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  EXPECT_NE(resumed.output.find("mapper       skipped: inputs and options unchanged"), std::string::npos)
+      << resumed.output;
+  ExpectEveryFileComplete(workspace);
+  EXPECT_EQ(CountFiles(workspace / "depth", ".exr"), 24u);
+}
+
 }  // namespace
 }  // namespace parallax
