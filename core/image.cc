@@ -70,6 +70,11 @@ Image ReadImage(const fs::path& path) {
   if (spec.depth != 1) {
     throw BadInputError("image " + path.string() + " is a volume; parallax reads 2D images");
   }
+  if (static_cast<double>(spec.width) * static_cast<double>(spec.height) > kMaxImageMegapixels * 1e6) {
+    throw BadInputError("image " + path.string() + " is " + std::to_string(spec.width) + "x" +
+                        std::to_string(spec.height) + ", over the " +
+                        std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded");
+  }
   Image image(spec.width, spec.height, spec.nchannels);
   // Integer formats are scaled to [0, 1] by OpenImageIO when read as float.
   if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT,

@@ -51,8 +51,13 @@ class Image {
 // How values are stored in a written file.
 enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 
+// Images larger than this are refused from their header, before anything is decoded (photos,
+// images read, cameras rendered): no camera sensor is larger (medium format reaches 102 MP),
+// and a header claiming more is a decompression bomb or a scan or panorama to downscale.
+constexpr double kMaxImageMegapixels = 128;
+
 // Reads any format OpenImageIO knows. Throws BadInputError (missing, unreadable, corrupt or
-// truncated file, more than 4 channels) naming the file.
+// truncated file, more than 4 channels, over kMaxImageMegapixels) naming the file.
 Image ReadImage(const std::filesystem::path& path);
 
 // How hard a lossless PNG is compressed: kFast (zlib level 1, OpenCV's imwrite default) for

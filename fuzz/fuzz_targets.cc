@@ -13,6 +13,10 @@
 #include "core/workspace.h"
 #include "geometry/ply.h"
 #include "geometry/obj.h"
+#include "reproject/distorted_target.h"
+#include "reproject/novel_views.h"
+#include "sfm/photo_conversion.h"
+#include "sfm/photo_set.h"
 #include "synth/scene.h"
 
 namespace parallax::fuzz {
@@ -52,6 +56,8 @@ const fs::path& Scratch() {
     fs::create_directories(path);
     WriteSparseModel(TinyModel(), path / "binary", SparseFormat::kBinary);
     WriteSparseModel(TinyModel(), path / "text", SparseFormat::kText);
+    WriteSparseModel(TinyModel(), path / "render", SparseFormat::kText);
+    WriteImage(path / "photos" / "a.png", Image(16, 16, 3), PixelFormat::kUint8);
     WriteFileAtomically(Workspace(path).MeshDir() / "mesh.mtl", "newmtl atlas\nmap_Kd mesh.png\n");
     WriteImage(Workspace(path).MeshDir() / "mesh.png", Image(2, 2, 3), PixelFormat::kUint8);
     return path;
@@ -112,6 +118,38 @@ void Obj(const uint8_t* data, size_t size) {
   Expect([&] { ReadTexturedMesh(file); });
 }
 
+// The names a fuzzed image is given (OpenImageIO picks its reader by the name first); the
+// input's first byte chooses one.
+const std::vector<std::string>& ImageExtensions() {
+  static const std::vector<std::string> extensions = {".png", ".jpg", ".tif", ".exr", ".bmp"};
+  return extensions;
+}
+
+// An image as parallax reads it: with ReadImage, and as a photo beside a valid one (scanned
+// from its header, decoded, and converted when COLMAP could not read it as it is).
+void ImageFile(const uint8_t* data, size_t size) {
+  if (size == 0) return;
+  const fs::path folder = Scratch() / "photos";
+  const std::string& extension = ImageExtensions()[data[0] % ImageExtensions().size()];
+  const fs::path file = Put(folder / ("b" + extension), data + 1, size - 1);
+  Expect([&] { ReadImage(file); });
+  Expect([&] {
+    for (const Photo& photo : ScanPhotos(folder).photos) {
+      if (!photo.conversion.empty()) WriteReadablePhoto(folder / photo.name, Scratch() / "converted" / photo.name);
+    }
+  });
+  fs::remove(file);
+}
+
+// The cameras file of a model given to `render --cameras`, turned into the cameras rendered.
+void RenderCameras(const uint8_t* data, size_t size) {
+  const fs::path folder = Scratch() / "render";
+  Put(folder / "cameras.txt", data, size);
+  Expect([&] {
+    for (const NamedCamera& target : CamerasFromModel(folder)) RenderedCamera(target.camera);
+  });
+}
+
 }  // namespace
 
 const std::vector<Target>& Targets() {
@@ -120,7 +158,8 @@ const std::vector<Target>& Targets() {
       {"sparse_binary_points", BinaryPoints},   {"sparse_text_cameras", TextCameras},
       {"sparse_text_images", TextImages},       {"sparse_text_points", TextPoints},
       {"dense_array", DenseArray},              {"scene_json", SceneJson},
-      {"ply", Ply},                             {"obj", Obj}};
+      {"ply", Ply},                             {"obj", Obj},
+      {"image", ImageFile},                     {"render_cameras", RenderCameras}};
   return targets;
 }
 
@@ -155,6 +194,17 @@ void WriteSeeds(const fs::path& dir) {
   ply += '\3';
   for (int32_t index : {0, 1, 2}) ply.append(reinterpret_cast<const char*>(&index), sizeof(index));
   WriteFileAtomically(dir / "ply" / "seed_mesh", ply);
+  Image gradient(8, 6, 3);
+  for (size_t i = 0; i < gradient.Pixels().size(); ++i) gradient.Pixels()[i] = static_cast<float>(i % 7) / 6.0f;
+  for (size_t i = 0; i < ImageExtensions().size(); ++i) {
+    const fs::path image = scratch / ("seed" + ImageExtensions()[i]);
+    WriteImage(image, gradient, ImageExtensions()[i] == ".exr" ? PixelFormat::kHalf : PixelFormat::kUint8);
+    std::string seed(1, static_cast<char>(i));  // The first byte picks the extension.
+    seed += ReadFileBytes(image);
+    WriteFileAtomically(dir / "image" / ("seed" + ImageExtensions()[i]), seed);
+  }
+  WriteFileAtomically(dir / "render_cameras" / "seed_pinhole", ReadFileBytes(scratch / "render" / "cameras.txt"));
+  WriteFileAtomically(dir / "render_cameras" / "seed_opencv", "1 OPENCV 64 48 50 50 32 24 0.1 0.01 0.001 -0.002\n");
   WriteFileAtomically(dir / "obj" / "seed_triangle",
                       "mtllib mesh.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                       "usemtl atlas\nf 1/1 2/2 3/3\n");

@@ -1,6 +1,7 @@
 #pragma once
 // Fuzz targets for every reader of untrusted files: COLMAP sparse models (binary and text),
-// COLMAP dense arrays, scene JSON, PLY and OBJ. Each takes arbitrary bytes, hands them to the
+// COLMAP dense arrays, scene JSON, PLY, OBJ, images (as photos and as read) and the camera
+// files `render` takes. Each takes arbitrary bytes, hands them to the
 // reader as the file it reads, and accepts only two outcomes: a result, or BadInputError.
 // Anything else (a crash, a sanitizer report, another exception, a huge allocation) is a bug.
 //

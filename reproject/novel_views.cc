@@ -115,12 +115,34 @@ ViewSetPaths SourcePathsFor(const fs::path& root) {
                       "reconstruct) nor a scene folder (gt/sparse, gt/depth)");
 }
 
+namespace {
+
+// A camera from a file is rendered only within the image size limit, and only if its
+// distortion can be inverted somewhere (distorted_target.h).
+void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
+  const Camera& camera = target.camera.camera;
+  const std::string where = model_dir.string() + ": camera " + std::to_string(camera.id) + " of " + target.name;
+  if (static_cast<double>(camera.width) * static_cast<double>(camera.height) > kMaxImageMegapixels * 1e6) {
+    throw BadInputError(where + " is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                        ", over the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) +
+                        " MP an image may have");
+  }
+  try {
+    RenderedCamera(target.camera);
+  } catch (const std::invalid_argument& error) {
+    throw BadInputError(where + " cannot be rendered: " + error.what());
+  }
+}
+
+}  // namespace
+
 std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
   const SparseModel model = ReadSparseModel(model_dir);
   std::vector<NamedCamera> cameras;
   for (const SparseImage& image : model.Images()) {
     cameras.push_back({fs::path(image.name).stem().string(),
                        {model.CameraById(image.camera_id), image.cam_from_world}});
+    CheckRenderable(model_dir, cameras.back());
   }
   if (cameras.empty()) throw BadInputError(model_dir.string() + ": the model has no images");
   return cameras;

@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/hash.h"
+#include "core/image.h"
 #include "sfm/photo_conversion.h"
 
 namespace parallax {
@@ -68,11 +69,11 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   photo.height = turned ? spec.width : spec.height;
   if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
   const double megapixels = static_cast<double>(spec.width) * static_cast<double>(spec.height) / 1e6;
-  if (megapixels > kMaxPhotoMegapixels) {
+  if (megapixels > kMaxImageMegapixels) {
     char reason[160];
     std::snprintf(reason, sizeof reason, "is %dx%d (%.0f MP), over the %.0f MP limit (a decompression bomb, or a "
                   "scan or panorama to downscale first); not decoded", spec.width, spec.height, megapixels,
-                  kMaxPhotoMegapixels);
+                  kMaxImageMegapixels);
     return std::string(reason);
   }
   const float focal_35mm = spec.get_float_attribute("Exif:FocalLengthIn35mmFilm", 0.0f);

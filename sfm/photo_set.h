@@ -41,14 +41,9 @@ struct PhotoSet {
   bool NeedsConversion() const;
 };
 
-// Photos larger than this are refused from their header, before anything is decoded: no
-// camera sensor is larger (medium format reaches 102 MP), and decoding one costs 3 bytes a
-// pixel here and 12 in the depth stage.
-constexpr double kMaxPhotoMegapixels = 128;
-
 // Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.
 // Unreadable, corrupt or non-image files, formats other than JPEG, PNG, TIFF and BMP, images
-// over kMaxPhotoMegapixels and identical copies of an earlier photo (by name) are skipped
+// over kMaxImageMegapixels (core/image.h) and identical copies of an earlier photo (by name) are skipped
 // with their reason. Sizes are those of the photo turned upright (EXIF orientation). Throws BadInputError
 // if the folder does not exist, is not a folder, or holds fewer than 2 readable images (the
 // message lists the skipped files).

@@ -253,16 +253,15 @@ TEST(ReconstructCli, ColmapFailingExitsThreeWithItsStatusLastLinesAndLog) {
   const TempDir dir;
   const fs::path photos = dir.Path() / "photos";
   fs::create_directories(photos);
-  // Two unrelated pictures: nothing to match.
-  fs::copy_file(kSmallImages / "0000.png", photos / "a.png");
-  Image noise(320, 240, 3);
-  uint32_t state = 12345;
-  for (float& value : noise.Pixels()) {
-    state = state * 1664525u + 1013904223u;
-    value = static_cast<float>(state >> 24) / 255.0f;
-  }
-  WriteImage(photos / "b.png", noise, PixelFormat::kUint8);
-  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws"));
+  for (const char* name : {"0000.png", "0001.png", "0002.png", "0003.png"}) fs::copy_file(kSmallImages / name, photos / name);
+  // The real colmap, its mapper asked for more matches than any pair has: a failure the
+  // photos do not explain.
+  const fs::path colmap = dir.Path() / "colmap";
+  std::ofstream(colmap) << "#!/bin/sh\n"
+                           "if [ \"$1\" = mapper ]; then exec colmap \"$@\" --Mapper.min_num_matches 100000; fi\n"
+                           "exec colmap \"$@\"\n";
+  fs::permissions(colmap, fs::perms::owner_all);
+  const CliResult result = RunParallax(Reconstruct(photos, dir.Path() / "ws", "--colmap " + Quote(colmap.string())));
   ExpectFailure(result, 3, "colmap mapper failed with exit status");
   EXPECT_NE(result.output.find("  | "), std::string::npos) << result.output;  // Log lines.
   EXPECT_NE(result.output.find("mapper.log"), std::string::npos) << result.output;

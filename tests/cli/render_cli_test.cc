@@ -251,6 +251,20 @@ TEST(RenderCli, BadInputExitsTwoAndNamesTheProblem) {
   const CliResult no_cameras =
       RunParallax("render " + Quote(kSmall.string()) + " --out " + Quote((dir.Path() / "o").string()));
   EXPECT_EQ(no_cameras.exit_code, 1) << no_cameras.output;
+  // Cameras no render can serve: beyond the image size limit, or a distortion that folds every
+  // border pixel away.
+  for (const auto& [camera, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"1 PINHOLE 100000 100000 280 280 160 120", "is 100000x100000, over the 128 MP"},
+           {"1 SIMPLE_RADIAL 320 240 280 160 120 -50", "cannot be rendered"}}) {
+    const fs::path cameras = dir.Path() / "cameras";
+    fs::remove_all(cameras);
+    fs::copy(kSmall / "novel" / "sparse", cameras);
+    std::ofstream(cameras / "cameras.txt") << camera << "\n";
+    const CliResult result = RunParallax("render " + Quote(kSmall.string()) + " --cameras " + Quote(cameras.string()) +
+                                         " --out " + Quote((dir.Path() / "o").string()));
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_NE(result.output.find(expected), std::string::npos) << result.output;
+  }
 }
 
 }  // namespace
