@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -39,6 +41,48 @@ Image MapColorChannels(const Image& input, float (*function)(float)) {
   return output;
 }
 
+// What an OpenEXR file's header claims, checked before OpenEXR reads it: found by fuzzing, a
+// 164-byte header whose attribute sizes run past the file makes OpenEXR take 2 GB. Throws
+// BadInputError for an attribute larger than the file, a data window over
+// kMaxImageMegapixels, or a multi-part or deep file (parallax writes neither).
+void CheckExrHeader(const fs::path& path) {
+  constexpr size_t kMaxHeaderBytes = 1 << 20;
+  std::ifstream file(path, std::ios::binary);
+  std::string bytes(kMaxHeaderBytes, '\0');
+  file.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  bytes.resize(static_cast<size_t>(file.gcount()));
+  if (bytes.size() < 8 || bytes.compare(0, 4, "\x76\x2f\x31\x01") != 0) return;  // Not EXR.
+  std::error_code error;
+  const auto file_size = static_cast<int64_t>(fs::file_size(path, error));
+  const auto fail = [&](const std::string& what) { throw BadInputError("image " + path.string() + " " + what); };
+  if (static_cast<unsigned char>(bytes[5]) & 0x18) fail("is a deep or multi-part OpenEXR file; parallax reads single-part images");
+  const auto read_int = [&](size_t at) {
+    int32_t value;
+    std::memcpy(&value, bytes.data() + at, sizeof value);
+    return value;
+  };
+  size_t at = 8;
+  while (at < bytes.size() && bytes[at] != '\0') {
+    const size_t name_end = bytes.find('\0', at);
+    const size_t type_end = name_end == std::string::npos ? name_end : bytes.find('\0', name_end + 1);
+    if (type_end == std::string::npos || type_end + 4 > bytes.size()) return;  // Beyond what was read.
+    const std::string name = bytes.substr(at, name_end - at);
+    const int32_t size = read_int(type_end + 1);
+    at = type_end + 5;
+    if (size < 0 || static_cast<int64_t>(at) + size > file_size) fail("is corrupt: its header attribute '" + name + "' runs past the end of the file");
+    if (name == "dataWindow" && size == 16 && at + 16 <= bytes.size()) {
+      const double width = static_cast<double>(read_int(at + 8)) - read_int(at) + 1;
+      const double height = static_cast<double>(read_int(at + 12)) - read_int(at + 4) + 1;
+      if (!(width >= 1 && height >= 1)) fail("is corrupt: its data window is empty");
+      if (width * height > kMaxImageMegapixels * 1e6) {
+        fail("claims " + std::to_string(static_cast<int64_t>(width)) + "x" + std::to_string(static_cast<int64_t>(height)) +
+             " pixels, over the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded");
+      }
+    }
+    at += static_cast<size_t>(size);
+  }
+}
+
 }  // namespace
 
 Image::Image(int width, int height, int channels) { Reset(width, height, channels); }
@@ -58,6 +102,7 @@ Image ReadImage(const fs::path& path) {
   // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG color by alpha.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
+  CheckExrHeader(path);
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {
     throw BadInputError("cannot read image " + path.string() + ": " + OIIO::geterror());

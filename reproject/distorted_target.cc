@@ -43,6 +43,10 @@ Camera PinholeCovering(const Camera& camera) {
   low.y() = std::max(low.y(), -2 * camera.PrincipalY() / fy);
   high.x() = std::min(high.x(), 2 * (width - camera.PrincipalX()) / fx);
   high.y() = std::min(high.y(), 2 * (height - camera.PrincipalY()) / fy);
+  if (!(low.x() < high.x() && low.y() < high.y())) {  // A principal point far off the image.
+    throw std::invalid_argument("camera " + std::to_string(camera.id) + ": its principal point lies too far outside "
+                                "its image to render it");
+  }
   const double left = std::floor(low.x() * fx), top = std::floor(low.y() * fy);
   const auto pinhole_width = static_cast<uint64_t>(std::ceil(high.x() * fx) - left);
   const auto pinhole_height = static_cast<uint64_t>(std::ceil(high.y() * fy) - top);

@@ -29,23 +29,18 @@ std::string FormatFromSignature(const fs::path& path) {
 }  // namespace
 
 std::unique_ptr<OIIO::ImageInput> OpenPhoto(const fs::path& path, std::string& error) {
+  const std::string format = FormatFromSignature(path);
+  if (format.empty()) {
+    error = "is not an image in a photo format (PNG, JPEG, TIFF or BMP)";
+    return nullptr;
+  }
   // Keep colour as stored where alpha is 0: OpenImageIO would otherwise premultiply it.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  const std::string format = FormatFromSignature(path);
-  if (format.empty()) {
-    auto input = OIIO::ImageInput::open(path.string(), &config);
-    if (!input) error = OIIO::geterror();
-    return input;
-  }
   auto input = OIIO::ImageInput::create(format);
   OIIO::ImageSpec spec;
-  if (!input) {
-    error = OIIO::geterror();
-    return nullptr;
-  }
-  if (!input->open(path.string(), spec, config)) {
-    error = input->geterror();
+  if (!input || !input->open(path.string(), spec, config)) {
+    error = "is not an image OpenImageIO can read (" + (input ? input->geterror() : OIIO::geterror()) + ")";
     return nullptr;
   }
   return input;
@@ -54,7 +49,7 @@ std::unique_ptr<OIIO::ImageInput> OpenPhoto(const fs::path& path, std::string& e
 void WriteReadablePhoto(const fs::path& from, const fs::path& to) {
   std::string error;
   const auto input = OpenPhoto(from, error);
-  if (!input) throw BadInputError("cannot convert " + from.string() + ": " + error);
+  if (!input) throw BadInputError("cannot convert " + from.string() + ": it " + error);
   OIIO::ImageSpec spec = input->spec();
   spec.set_format(OIIO::TypeDesc::UINT8);
   OIIO::ImageBuf source(spec);

@@ -11,9 +11,10 @@
 namespace parallax {
 
 // Opens `path` with the reader its content calls for (PNG, JPEG, TIFF and BMP recognised by
-// their first bytes), whatever its name says; other content by its name, as OpenImageIO
-// does. OpenImageIO's own fallback for a misnamed file failed now and then with several files
-// opened at once. Null when no reader opens it, with `error` saying why.
+// their first bytes), whatever its name says: OpenImageIO's own fallback for a misnamed file
+// failed now and then with several files opened at once, and other formats are never handed
+// to a reader (a 164-byte EXR header found by fuzzing makes OpenEXR take 2 GB). Null when it
+// is none of these or the reader refuses it, with `error` saying why ("is not ...").
 std::unique_ptr<OIIO::ImageInput> OpenPhoto(const std::filesystem::path& path, std::string& error);
 
 // Writes `from` to `to` (atomically) as 8-bit RGB in the format `to`'s extension names,

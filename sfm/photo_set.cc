@@ -55,10 +55,9 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   photo.content_hash = Hasher().Add(bytes).Value();
   std::string error;
   const auto input = OpenPhoto(path, error);
-  if (!input) return "is not an image OpenImageIO can read";
+  if (!input) return error;
   const OIIO::ImageSpec& spec = input->spec();
   const std::string format = input->format_name();
-  if (!IsPhotoFormat(format)) return "is a " + format + " image, not a photo format (JPEG, PNG, TIFF or BMP)";
   const auto named = OIIO::ImageOutput::create(path.filename().string());
   if (!named || !IsPhotoFormat(named->format_name())) {
     return "is a " + format + " image without a photo file extension (.jpg, .png, .tif or .bmp)";

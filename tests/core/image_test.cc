@@ -1,6 +1,7 @@
 #include "core/image.h"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -109,6 +110,38 @@ TEST(Image, ReadingCorruptOrMissingFilesNamesTheFile) {
   std::ofstream(dir.Path() / "truncated.png", std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
   EXPECT_THROW(ReadImage(dir.Path() / "truncated.png"), BadInputError);
+}
+
+// An EXR header is checked before OpenEXR reads it: a data window over the pixel limit, or an
+// attribute larger than the file (a 164-byte input that made OpenEXR take 2 GB), is refused.
+TEST(Image, ExrHeadersClaimingTooMuchAreRefusedBeforeDecoding) {
+  const TempDir dir;
+  const std::filesystem::path path = dir.Path() / "huge.exr";
+  WriteImage(path, Image(4, 4, 1), PixelFormat::kHalf);
+  std::string bytes;
+  {
+    std::ifstream file(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(file), {});
+  }
+  const std::string key("dataWindow\0box2i\0", 17);
+  const size_t at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  const int32_t corner = 99999;
+  for (size_t offset : {size_t{8}, size_t{12}}) std::memcpy(&bytes[at + key.size() + 4 + offset], &corner, 4);
+  std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  try {
+    ReadImage(path);
+    FAIL() << "read";
+  } catch (const BadInputError& error) {
+    EXPECT_NE(std::string(error.what()).find("claims 100000x100000 pixels, over the 128 MP limit"), std::string::npos)
+        << error.what();
+  }
+  const std::filesystem::path fuzzed = std::filesystem::path(PARALLAX_SOURCE_DIR) / "fuzz" / "corpus" / "image" /
+                                       "oom-9c45bac25791af1ef2c637f764c39cf9191af3c4";
+  std::ifstream input(fuzzed, std::ios::binary);
+  const std::string header((std::istreambuf_iterator<char>(input)), {});
+  std::ofstream(dir.Path() / "fuzzed.exr", std::ios::binary).write(header.data() + 1, static_cast<std::streamsize>(header.size() - 1));
+  EXPECT_THROW(ReadImage(dir.Path() / "fuzzed.exr"), BadInputError);
 }
 
 TEST(Image, WritingNanIsRefusedAndLeavesNoFile) {

@@ -83,7 +83,7 @@ TEST(PhotoConversion, FormsColmapCannotReadAreFlaggedAndTheOthersAreNot) {
   EXPECT_EQ(Find(set, "turned.tif").height, 20);
   ASSERT_EQ(set.skipped.size(), 1u);
   EXPECT_EQ(set.skipped[0].name, "linear.exr");
-  EXPECT_NE(set.skipped[0].reason.find("not a photo format"), std::string::npos) << set.skipped[0].reason;
+  EXPECT_NE(set.skipped[0].reason.find("is not an image in a photo format"), std::string::npos) << set.skipped[0].reason;
   EXPECT_TRUE(set.NeedsConversion());
 }
 
