@@ -41,19 +41,37 @@ Image MapColorChannels(const Image& input, float (*function)(float)) {
   return output;
 }
 
-// What an OpenEXR file's header claims, checked before OpenEXR reads it: found by fuzzing, a
-// 164-byte header whose attribute sizes run past the file makes OpenEXR take 2 GB. Throws
-// BadInputError for an attribute larger than the file, a data window over
-// kMaxImageMegapixels, or a multi-part or deep file (parallax writes neither).
-void CheckExrHeader(const fs::path& path) {
+// The first MiB of a file: enough for the headers CheckImageHeader walks.
+std::string FileStart(const fs::path& path) {
   constexpr size_t kMaxHeaderBytes = 1 << 20;
   std::ifstream file(path, std::ios::binary);
   std::string bytes(kMaxHeaderBytes, '\0');
   file.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   bytes.resize(static_cast<size_t>(file.gcount()));
-  if (bytes.size() < 8 || bytes.compare(0, 4, "\x76\x2f\x31\x01") != 0) return;  // Not EXR.
-  std::error_code error;
-  const auto file_size = static_cast<int64_t>(fs::file_size(path, error));
+  return bytes;
+}
+
+// Every PNG chunk must fit in the file: found by fuzzing, a 169-byte PNG whose text chunk
+// claims more makes libpng (through OpenImageIO) take 2 GB.
+void CheckPngChunks(const fs::path& path, const std::string& bytes, int64_t file_size) {
+  size_t at = 8;
+  while (at + 8 <= bytes.size()) {
+    const auto byte = [&](size_t i) { return static_cast<uint32_t>(static_cast<unsigned char>(bytes[at + i])); };
+    const uint32_t length = byte(0) << 24 | byte(1) << 16 | byte(2) << 8 | byte(3);
+    if (static_cast<int64_t>(at) + 12 + length > file_size) {
+      throw BadInputError("image " + path.string() + " is corrupt: its chunk '" + bytes.substr(at + 4, 4) +
+                          "' runs past the end of the file");
+    }
+    if (bytes.compare(at + 4, 4, "IEND") == 0) return;
+    at += 12 + static_cast<size_t>(length);
+  }
+}
+
+// What an OpenEXR file's header claims: found by fuzzing, a 164-byte header whose attribute
+// sizes run past the file makes OpenEXR take 2 GB. Refuses an attribute larger than the file,
+// a data window over kMaxImageMegapixels, or a multi-part or deep file (parallax writes
+// neither).
+void CheckExrHeader(const fs::path& path, const std::string& bytes, int64_t file_size) {
   const auto fail = [&](const std::string& what) { throw BadInputError("image " + path.string() + " " + what); };
   if (static_cast<unsigned char>(bytes[5]) & 0x18) fail("is a deep or multi-part OpenEXR file; parallax reads single-part images");
   const auto read_int = [&](size_t at) {
@@ -65,7 +83,7 @@ void CheckExrHeader(const fs::path& path) {
   while (at < bytes.size() && bytes[at] != '\0') {
     const size_t name_end = bytes.find('\0', at);
     const size_t type_end = name_end == std::string::npos ? name_end : bytes.find('\0', name_end + 1);
-    if (type_end == std::string::npos || type_end + 4 > bytes.size()) return;  // Beyond what was read.
+    if (type_end == std::string::npos || type_end + 5 > bytes.size()) return;  // Beyond what was read.
     const std::string name = bytes.substr(at, name_end - at);
     const int32_t size = read_int(type_end + 1);
     at = type_end + 5;
@@ -98,11 +116,20 @@ void Image::Reset(int width, int height, int channels) {
   pixels_.assign(static_cast<size_t>(width) * height * channels, 0.0f);
 }
 
+void CheckImageHeader(const fs::path& path) {
+  const std::string bytes = FileStart(path);
+  std::error_code error;
+  const auto file_size = static_cast<int64_t>(fs::file_size(path, error));
+  if (error || bytes.size() < 8) return;  // The reader says what is wrong.
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) CheckPngChunks(path, bytes, file_size);
+  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) CheckExrHeader(path, bytes, file_size);
+}
+
 Image ReadImage(const fs::path& path) {
   // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG color by alpha.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  CheckExrHeader(path);
+  CheckImageHeader(path);
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {
     throw BadInputError("cannot read image " + path.string() + ": " + OIIO::geterror());

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/image.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -32,6 +33,12 @@ std::unique_ptr<OIIO::ImageInput> OpenPhoto(const fs::path& path, std::string& e
   const std::string format = FormatFromSignature(path);
   if (format.empty()) {
     error = "is not an image in a photo format (PNG, JPEG, TIFF or BMP)";
+    return nullptr;
+  }
+  try {
+    CheckImageHeader(path);
+  } catch (const BadInputError& bad) {
+    error = "is not an image OpenImageIO can read (" + std::string(bad.what()) + ")";
     return nullptr;
   }
   // Keep colour as stored where alpha is 0: OpenImageIO would otherwise premultiply it.
