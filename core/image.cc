@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -41,7 +42,7 @@ Image MapColorChannels(const Image& input, float (*function)(float)) {
   return output;
 }
 
-// The first MiB of a file: enough for the headers CheckImageHeader walks.
+// The first MiB of a file: enough for the headers ImageHeaderProblem walks.
 std::string FileStart(const fs::path& path) {
   constexpr size_t kMaxHeaderBytes = 1 << 20;
   std::ifstream file(path, std::ios::binary);
@@ -53,27 +54,26 @@ std::string FileStart(const fs::path& path) {
 
 // Every PNG chunk must fit in the file: found by fuzzing, a 169-byte PNG whose text chunk
 // claims more makes libpng (through OpenImageIO) take 2 GB.
-void CheckPngChunks(const fs::path& path, const std::string& bytes, int64_t file_size) {
+std::optional<std::string> PngChunkProblem(const std::string& bytes, int64_t file_size) {
   size_t at = 8;
   while (at + 8 <= bytes.size()) {
     const auto byte = [&](size_t i) { return static_cast<uint32_t>(static_cast<unsigned char>(bytes[at + i])); };
     const uint32_t length = byte(0) << 24 | byte(1) << 16 | byte(2) << 8 | byte(3);
     if (static_cast<int64_t>(at) + 12 + length > file_size) {
-      throw BadInputError("image " + path.string() + " is corrupt: its chunk '" + bytes.substr(at + 4, 4) +
-                          "' runs past the end of the file");
+      return "is corrupt or truncated: its chunk '" + bytes.substr(at + 4, 4) + "' runs past the end of the file";
     }
-    if (bytes.compare(at + 4, 4, "IEND") == 0) return;
+    if (bytes.compare(at + 4, 4, "IEND") == 0) return std::nullopt;
     at += 12 + static_cast<size_t>(length);
   }
+  return std::nullopt;
 }
 
 // What an OpenEXR file's header claims: found by fuzzing, a 164-byte header whose attribute
 // sizes run past the file makes OpenEXR take 2 GB. Refuses an attribute larger than the file,
 // a data window over kMaxImageMegapixels, or a multi-part or deep file (parallax writes
 // neither).
-void CheckExrHeader(const fs::path& path, const std::string& bytes, int64_t file_size) {
-  const auto fail = [&](const std::string& what) { throw BadInputError("image " + path.string() + " " + what); };
-  if (static_cast<unsigned char>(bytes[5]) & 0x18) fail("is a deep or multi-part OpenEXR file; parallax reads single-part images");
+std::optional<std::string> ExrHeaderProblem(const std::string& bytes, int64_t file_size) {
+  if (static_cast<unsigned char>(bytes[5]) & 0x18) return "is a deep or multi-part OpenEXR file; parallax reads single-part images";
   const auto read_int = [&](size_t at) {
     int32_t value;
     std::memcpy(&value, bytes.data() + at, sizeof value);
@@ -83,22 +83,26 @@ void CheckExrHeader(const fs::path& path, const std::string& bytes, int64_t file
   while (at < bytes.size() && bytes[at] != '\0') {
     const size_t name_end = bytes.find('\0', at);
     const size_t type_end = name_end == std::string::npos ? name_end : bytes.find('\0', name_end + 1);
-    if (type_end == std::string::npos || type_end + 5 > bytes.size()) return;  // Beyond what was read.
+    if (type_end == std::string::npos || type_end + 5 > bytes.size()) return std::nullopt;  // Beyond what was read.
     const std::string name = bytes.substr(at, name_end - at);
     const int32_t size = read_int(type_end + 1);
     at = type_end + 5;
-    if (size < 0 || static_cast<int64_t>(at) + size > file_size) fail("is corrupt: its header attribute '" + name + "' runs past the end of the file");
+    if (size < 0 || static_cast<int64_t>(at) + size > file_size) {
+      return "is corrupt or truncated: its header attribute '" + name + "' runs past the end of the file";
+    }
     if (name == "dataWindow" && size == 16 && at + 16 <= bytes.size()) {
       const double width = static_cast<double>(read_int(at + 8)) - read_int(at) + 1;
       const double height = static_cast<double>(read_int(at + 12)) - read_int(at + 4) + 1;
-      if (!(width >= 1 && height >= 1)) fail("is corrupt: its data window is empty");
+      if (!(width >= 1 && height >= 1)) return "is corrupt: its data window is empty";
       if (width * height > kMaxImageMegapixels * 1e6) {
-        fail("claims " + std::to_string(static_cast<int64_t>(width)) + "x" + std::to_string(static_cast<int64_t>(height)) +
-             " pixels, over the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded");
+        return "claims " + std::to_string(static_cast<int64_t>(width)) + "x" +
+               std::to_string(static_cast<int64_t>(height)) + " pixels, over the " +
+               std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded";
       }
     }
     at += static_cast<size_t>(size);
   }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -116,20 +120,21 @@ void Image::Reset(int width, int height, int channels) {
   pixels_.assign(static_cast<size_t>(width) * height * channels, 0.0f);
 }
 
-void CheckImageHeader(const fs::path& path) {
+std::optional<std::string> ImageHeaderProblem(const fs::path& path) {
   const std::string bytes = FileStart(path);
   std::error_code error;
   const auto file_size = static_cast<int64_t>(fs::file_size(path, error));
-  if (error || bytes.size() < 8) return;  // The reader says what is wrong.
-  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) CheckPngChunks(path, bytes, file_size);
-  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) CheckExrHeader(path, bytes, file_size);
+  if (error || bytes.size() < 8) return std::nullopt;  // The reader says what is wrong.
+  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return PngChunkProblem(bytes, file_size);
+  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) return ExrHeaderProblem(bytes, file_size);
+  return std::nullopt;
 }
 
 Image ReadImage(const fs::path& path) {
   // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG color by alpha.
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);
-  CheckImageHeader(path);
+  if (const auto problem = ImageHeaderProblem(path)) throw BadInputError("image " + path.string() + " " + *problem);
   auto input = OIIO::ImageInput::open(path.string(), &config);
   if (!input) {
     throw BadInputError("cannot read image " + path.string() + ": " + OIIO::geterror());

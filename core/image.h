@@ -10,6 +10,8 @@
 //    and write through a temporary file.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace parallax {
@@ -56,11 +58,11 @@ enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 // and a header claiming more is a decompression bomb or a scan or panorama to downscale.
 constexpr double kMaxImageMegapixels = 128;
 
-// Checks what a PNG or OpenEXR file's header claims before a library reads it: chunks and
-// attributes that run past the end of the file, and data windows over kMaxImageMegapixels,
-// for which libpng and OpenEXR would allocate gigabytes. Throws BadInputError naming the file;
-// other formats pass.
-void CheckImageHeader(const std::filesystem::path& path);
+// What is wrong with a PNG or OpenEXR file's header, checked before a library reads it:
+// chunks and attributes that run past the end of the file, and data windows over
+// kMaxImageMegapixels, for which libpng and OpenEXR would allocate gigabytes. The problem as
+// a phrase ("is corrupt or truncated: ..."), or nullopt (other formats always).
+std::optional<std::string> ImageHeaderProblem(const std::filesystem::path& path);
 
 // Reads any format OpenImageIO knows. Throws BadInputError (missing, unreadable, corrupt or
 // truncated file, more than 4 channels, over kMaxImageMegapixels) naming the file.

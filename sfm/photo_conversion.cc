@@ -35,10 +35,8 @@ std::unique_ptr<OIIO::ImageInput> OpenPhoto(const fs::path& path, std::string& e
     error = "is not an image in a photo format (PNG, JPEG, TIFF or BMP)";
     return nullptr;
   }
-  try {
-    CheckImageHeader(path);
-  } catch (const BadInputError& bad) {
-    error = "is not an image OpenImageIO can read (" + std::string(bad.what()) + ")";
+  if (const auto problem = ImageHeaderProblem(path)) {
+    error = *problem;
     return nullptr;
   }
   // Keep colour as stored where alpha is 0: OpenImageIO would otherwise premultiply it.
