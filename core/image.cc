@@ -42,11 +42,10 @@ Image MapColorChannels(const Image& input, float (*function)(float)) {
   return output;
 }
 
-// The first MiB of a file: enough for the headers ImageHeaderProblem walks.
-std::string FileStart(const fs::path& path) {
-  constexpr size_t kMaxHeaderBytes = 1 << 20;
+// The first `size` bytes of a file, or fewer if it is shorter.
+std::string FileStart(const fs::path& path, size_t size) {
   std::ifstream file(path, std::ios::binary);
-  std::string bytes(kMaxHeaderBytes, '\0');
+  std::string bytes(size, '\0');
   file.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   bytes.resize(static_cast<size_t>(file.gcount()));
   return bytes;
@@ -94,7 +93,7 @@ std::optional<std::string> ExrHeaderProblem(const std::string& bytes, int64_t fi
       const double width = static_cast<double>(read_int(at + 8)) - read_int(at) + 1;
       const double height = static_cast<double>(read_int(at + 12)) - read_int(at + 4) + 1;
       if (!(width >= 1 && height >= 1)) return "is corrupt: its data window is empty";
-      if (width * height > kMaxImageMegapixels * 1e6) {
+      if (OverPixelLimit(width, height)) {
         return "claims " + std::to_string(static_cast<int64_t>(width)) + "x" +
                std::to_string(static_cast<int64_t>(height)) + " pixels, over the " +
                std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded";
@@ -121,13 +120,17 @@ void Image::Reset(int width, int height, int channels) {
 }
 
 std::optional<std::string> ImageHeaderProblem(const fs::path& path) {
-  const std::string bytes = FileStart(path);
   std::error_code error;
   const auto file_size = static_cast<int64_t>(fs::file_size(path, error));
-  if (error || bytes.size() < 8) return std::nullopt;  // The reader says what is wrong.
-  if (bytes.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return PngChunkProblem(bytes, file_size);
-  if (bytes.compare(0, 4, "\x76\x2f\x31\x01") == 0) return ExrHeaderProblem(bytes, file_size);
-  return std::nullopt;
+  if (error) return std::nullopt;  // The reader says what is wrong.
+  const std::string signature = FileStart(path, 8);
+  const bool png = signature == std::string("\x89PNG\r\n\x1a\n", 8);
+  const bool exr = signature.size() == 8 && signature.compare(0, 4, "\x76\x2f\x31\x01") == 0;
+  if (!png && !exr) return std::nullopt;
+  // The first MiB holds every header worth walking; past it, the reader checks on its own.
+  constexpr int64_t kMaxHeaderBytes = 1 << 20;
+  const std::string bytes = FileStart(path, static_cast<size_t>(std::min(file_size, kMaxHeaderBytes)));
+  return png ? PngChunkProblem(bytes, file_size) : ExrHeaderProblem(bytes, file_size);
 }
 
 Image ReadImage(const fs::path& path) {
@@ -147,7 +150,7 @@ Image ReadImage(const fs::path& path) {
   if (spec.depth != 1) {
     throw BadInputError("image " + path.string() + " is a volume; parallax reads 2D images");
   }
-  if (static_cast<double>(spec.width) * static_cast<double>(spec.height) > kMaxImageMegapixels * 1e6) {
+  if (OverPixelLimit(spec.width, spec.height)) {
     throw BadInputError("image " + path.string() + " is " + std::to_string(spec.width) + "x" +
                         std::to_string(spec.height) + ", over the " +
                         std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded");

@@ -57,6 +57,7 @@ enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 // images read, cameras rendered): no camera sensor is larger (medium format reaches 102 MP),
 // and a header claiming more is a decompression bomb or a scan or panorama to downscale.
 constexpr double kMaxImageMegapixels = 128;
+inline bool OverPixelLimit(double width, double height) { return width * height > kMaxImageMegapixels * 1e6; }
 
 // What is wrong with a PNG or OpenEXR file's header, checked before a library reads it:
 // chunks and attributes that run past the end of the file, and data windows over

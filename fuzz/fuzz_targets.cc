@@ -13,7 +13,6 @@
 #include "core/workspace.h"
 #include "geometry/ply.h"
 #include "geometry/obj.h"
-#include "reproject/distorted_target.h"
 #include "reproject/novel_views.h"
 #include "sfm/photo_conversion.h"
 #include "sfm/photo_set.h"
@@ -141,13 +140,12 @@ void ImageFile(const uint8_t* data, size_t size) {
   fs::remove(file);
 }
 
-// The cameras file of a model given to `render --cameras`, turned into the cameras rendered.
+// The cameras file of a model given to `render --cameras`, turned into the cameras rendered
+// (CamerasFromModel works out the camera each is rendered in, RenderedCamera).
 void RenderCameras(const uint8_t* data, size_t size) {
   const fs::path folder = Scratch() / "render";
   Put(folder / "cameras.txt", data, size);
-  Expect([&] {
-    for (const NamedCamera& target : CamerasFromModel(folder)) RenderedCamera(target.camera);
-  });
+  Expect([&] { CamerasFromModel(folder); });
 }
 
 }  // namespace

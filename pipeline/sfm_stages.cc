@@ -251,7 +251,6 @@ Stage PhotosStage(const fs::path& photos_dir, const PhotoSet& photos, const Work
     RemoveAll(output);
     fs::create_directories(output);
     const int total = static_cast<int>(photos.photos.size());
-    int done = 0;
     progress.Update("photos", 0, total);
     // Conversions in parallel, progress from this thread only (core/progress.h).
     for (int start = 0; start < total; start += 16) {
@@ -265,8 +264,7 @@ Stage PhotosStage(const fs::path& photos_dir, const PhotoSet& photos, const Work
         fs::create_hard_link(from, to, error);
         if (error) fs::copy_file(from, to);
       });
-      done = end;
-      progress.Update("photos", done, total);
+      progress.Update("photos", end, total);
     }
     Replace(output, workspace.ReadablePhotos());
   };

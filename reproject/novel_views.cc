@@ -122,7 +122,7 @@ namespace {
 void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
   const Camera& camera = target.camera.camera;
   const std::string where = model_dir.string() + ": camera " + std::to_string(camera.id) + " of " + target.name;
-  if (static_cast<double>(camera.width) * static_cast<double>(camera.height) > kMaxImageMegapixels * 1e6) {
+  if (OverPixelLimit(static_cast<double>(camera.width), static_cast<double>(camera.height))) {
     throw BadInputError(where + " is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
                         ", over the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) +
                         " MP an image may have");

@@ -68,7 +68,7 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   photo.height = turned ? spec.width : spec.height;
   if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
   const double megapixels = static_cast<double>(spec.width) * static_cast<double>(spec.height) / 1e6;
-  if (megapixels > kMaxImageMegapixels) {
+  if (OverPixelLimit(spec.width, spec.height)) {
     char reason[160];
     std::snprintf(reason, sizeof reason, "is %dx%d (%.0f MP), over the %.0f MP limit (a decompression bomb, or a "
                   "scan or panorama to downscale first); not decoded", spec.width, spec.height, megapixels,

@@ -43,8 +43,9 @@ struct PhotoSet {
 
 // Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.
 // Unreadable, corrupt or non-image files, formats other than JPEG, PNG, TIFF and BMP, images
-// over kMaxImageMegapixels (core/image.h) and identical copies of an earlier photo (by name) are skipped
-// with their reason. Sizes are those of the photo turned upright (EXIF orientation). Throws BadInputError
+// over kMaxImageMegapixels (core/image.h) and identical copies of an earlier photo (by name)
+// are skipped with their reason. Sizes are those of the photo turned upright (EXIF
+// orientation). Throws BadInputError
 // if the folder does not exist, is not a folder, or holds fewer than 2 readable images (the
 // message lists the skipped files).
 PhotoSet ScanPhotos(const std::filesystem::path& dir);
