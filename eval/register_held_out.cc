@@ -11,6 +11,8 @@
 #include "core/workspace.h"
 #include "colmap/runner.h"
 #include "colmap/database.h"
+#include "sfm/photo_conversion.h"
+#include "sfm/photo_set.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -32,11 +34,17 @@ std::map<std::string, std::string> StagedNames(const std::vector<std::string>& n
   return staged;
 }
 
-// Links (or copies) each photo into <work_dir>/photos under its staged name.
+// Links (or copies) each photo into <work_dir>/photos under its staged name; a photo colmap
+// cannot read as it is (16-bit, grey, turned, ...) is converted there as `reconstruct` does.
 void StagePhotos(const fs::path& images_dir, const std::map<std::string, std::string>& staged,
                  const fs::path& photos_dir) {
   fs::create_directories(photos_dir);
   for (const auto& [name, staged_name] : staged) {
+    Photo photo;
+    if (!CheckPhoto(images_dir / name, photo) && !photo.conversion.empty()) {
+      WriteReadablePhoto(images_dir / name, photos_dir / staged_name);
+      continue;
+    }
     std::error_code error;
     fs::create_hard_link(images_dir / name, photos_dir / staged_name, error);
     if (error) fs::copy_file(images_dir / name, photos_dir / staged_name);
@@ -115,7 +123,7 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   const std::map<std::string, std::string> staged = StagedNames(names, in_database);
   std::string pairs, list;
   Hasher key_hasher;
-  key_hasher.Add("held-out-3").Add(static_cast<uint64_t>(fs::file_size(database)));
+  key_hasher.Add("held-out-4").Add(static_cast<uint64_t>(fs::file_size(database)));
   std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
   std::sort(model_files.begin(), model_files.end());
   for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));

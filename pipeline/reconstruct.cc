@@ -267,9 +267,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   const SfmContext sfm{ReadablePhotosDir(photos_dir, photos, paths), photos, known ? &*known : nullptr, options, colmap,
                        paths, ChooseCameraSetup(photos, options, known ? &*known : nullptr),
                        sequential, progress};
-  summary.camera_model = std::string(CameraModelName(sfm.camera.model)) +
-                         (sfm.camera.single_camera ? ", one shared camera" : ", one camera per image") +
-                         (sfm.camera.fixed_intrinsics ? ", intrinsics fixed" : "");
+  summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = DescribeMatcher(options, num_images, sequential);
 
   const std::string conversions = DescribeConversions(photos, paths);

@@ -95,6 +95,45 @@ SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& 
   return aligned;
 }
 
+std::vector<std::string> PhotoNames(const PhotoSet& photos) {
+  std::vector<std::string> names;
+  for (const Photo& photo : photos.photos) names.push_back(photo.name);
+  return names;
+}
+
+// One feature_extractor run: the photos it reads, and whether they share one camera.
+struct ExtractionRun {
+  std::vector<std::string> names;
+  bool single_camera;
+};
+
+// The extractor runs that give the photos the cameras `sharing` asks for: COLMAP shares a
+// camera only among the photos of one run. Photos alone in their group are read in one run.
+std::vector<ExtractionRun> ExtractionRuns(const PhotoSet& photos, CameraSharing sharing) {
+  if (sharing != CameraSharing::kPerGroup) {
+    return {{PhotoNames(photos), sharing == CameraSharing::kAll}};
+  }
+  std::vector<ExtractionRun> runs;
+  ExtractionRun alone{{}, false};
+  for (const std::vector<size_t>& group : photos.CameraGroups()) {
+    ExtractionRun run{{}, true};
+    for (const size_t index : group) run.names.push_back(photos.photos[index].name);
+    if (group.size() == 1) {
+      alone.names.push_back(run.names.front());
+    } else {
+      runs.push_back(std::move(run));
+    }
+  }
+  if (!alone.names.empty()) runs.push_back(std::move(alone));
+  return runs;
+}
+
+std::string ImageListText(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += name + "\n";
+  return list;
+}
+
 // A final bundle adjustment that also frees the principal point, kept only when the point
 // stays near the image centre: where it is unobservable (a narrow arc of small images) it
 // drifts far off and the rotations with it.
@@ -199,9 +238,11 @@ CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& 
     const bool single = known->Cameras().size() == 1;
     const Camera& first = known->Cameras().front();
     return {single ? first.model : options.camera_model, single ? Join(first.params) : "",
-            single, true};
+            single ? CameraSharing::kAll : CameraSharing::kPerPhoto, true};
   }
-  if (options.intrinsics.empty()) return {options.camera_model, "", shared, false};
+  if (options.intrinsics.empty()) {
+    return {options.camera_model, "", shared ? CameraSharing::kAll : CameraSharing::kPerGroup, false};
+  }
   if (!shared && options.intrinsics.size() == 1) {
     throw BadInputError("--intrinsics f needs photos of one size (the principal point is put at "
                         "the image centre); give fx,fy,cx,cy or photos of one size");
@@ -209,9 +250,24 @@ CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& 
   const Photo& photo = photos.photos.front();
   if (options.intrinsics.size() == 1) {
     return {CameraModel::kSimplePinhole,
-            Join({options.intrinsics[0], photo.width / 2.0, photo.height / 2.0}), true, true};
+            Join({options.intrinsics[0], photo.width / 2.0, photo.height / 2.0}), CameraSharing::kAll,
+            true};
   }
-  return {CameraModel::kPinhole, Join(options.intrinsics), true, true};
+  return {CameraModel::kPinhole, Join(options.intrinsics), CameraSharing::kAll, true};
+}
+
+std::string DescribeCameraSetup(const CameraSetup& camera, const PhotoSet& photos) {
+  std::string sharing;
+  switch (camera.sharing) {
+    case CameraSharing::kAll: sharing = "one shared camera"; break;
+    case CameraSharing::kPerGroup:
+      sharing = "one camera per photo size and EXIF camera (" +
+                std::to_string(photos.CameraGroups().size()) + " cameras)";
+      break;
+    case CameraSharing::kPerPhoto: sharing = "one camera per image"; break;
+  }
+  return std::string(CameraModelName(camera.model)) + ", " + sharing +
+         (camera.fixed_intrinsics ? ", intrinsics fixed" : "");
 }
 
 bool UseSequentialMatcher(const ReconstructOptions& options, int num_images) {
@@ -298,36 +354,45 @@ Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key) {
   Hasher hasher;
   // Without conversions the photos stage changes nothing COLMAP reads (and keeps old keys).
   if (sfm.photos.NeedsConversion()) hasher.Add(photos_key);
+  if (sfm.camera.sharing == CameraSharing::kPerGroup) hasher.Add("camera per group");
   stage.key = hasher
                   .Add(sfm.photos.ContentHash())
                   .Add(CameraModelName(sfm.camera.model))
                   .Add(sfm.camera.params)
-                  .Add(sfm.camera.single_camera)
+                  .Add(sfm.camera.sharing == CameraSharing::kAll)
                   .Add(static_cast<uint64_t>(quality.max_image_size))
                   .Add(static_cast<uint64_t>(quality.max_num_features))
                   .Hex();
   stage.outputs = {paths.Database()};
   stage.run = [&sfm, quality, paths] {
     fs::create_directories(paths.Sfm());
-    std::string list;
-    for (const Photo& photo : sfm.photos.photos) list += photo.name + "\n";
-    WriteFileAtomically(paths.ImageList(), list);
+    const std::vector<ExtractionRun> runs = ExtractionRuns(sfm.photos, sfm.camera.sharing);
+    WriteFileAtomically(paths.ImageList(), ImageListText(PhotoNames(sfm.photos)));
     const fs::path database = paths.Database().string() + ".tmp";
     const TemporaryDatabase temporary(database);
     RemoveAll(database);
-    std::vector<std::string> arguments = {
-        "--database_path", database.string(), "--image_path", sfm.photos_dir.string(),
-        "--image_list_path", paths.ImageList().string(),
-        "--ImageReader.camera_model", std::string(CameraModelName(sfm.camera.model)),
-        "--ImageReader.single_camera", sfm.camera.single_camera ? "1" : "0",
-        "--SiftExtraction.use_gpu", "0",
-        "--SiftExtraction.max_image_size", std::to_string(quality.max_image_size),
-        "--SiftExtraction.max_num_features", std::to_string(quality.max_num_features)};
-    if (!sfm.camera.params.empty()) {
-      arguments.insert(arguments.end(), {"--ImageReader.camera_params", sfm.camera.params});
+    const fs::path run_list = paths.Sfm() / "image_list_camera.txt";
+    const TemporaryOutput temporary_list(run_list);
+    for (size_t i = 0; i < runs.size(); ++i) {
+      WriteFileAtomically(run_list, ImageListText(runs[i].names));
+      std::vector<std::string> arguments = {
+          "--database_path", database.string(), "--image_path", sfm.photos_dir.string(),
+          "--image_list_path", run_list.string(),
+          "--ImageReader.camera_model", std::string(CameraModelName(sfm.camera.model)),
+          "--ImageReader.single_camera", runs[i].single_camera ? "1" : "0",
+          "--SiftExtraction.use_gpu", "0",
+          "--SiftExtraction.max_image_size", std::to_string(quality.max_image_size),
+          "--SiftExtraction.max_num_features", std::to_string(quality.max_num_features)};
+      if (!sfm.camera.params.empty()) {
+        arguments.insert(arguments.end(), {"--ImageReader.camera_params", sfm.camera.params});
+      }
+      const std::string label =
+          runs.size() == 1 ? "features"
+                           : "features, camera group " + std::to_string(i + 1) + "/" + std::to_string(runs.size());
+      sfm.colmap.Run("feature_extractor", arguments, paths.Log("features"), label,
+                     static_cast<int>(runs[i].names.size()), sfm.progress);
     }
-    sfm.colmap.Run("feature_extractor", arguments, paths.Log("features"), "features",
-                   static_cast<int>(sfm.photos.photos.size()), sfm.progress);
+    fs::remove(run_list);
     fs::rename(database, paths.Database());
   };
   return stage;
@@ -390,7 +455,7 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
   const Workspace& paths = sfm.workspace;
   const int num_images = static_cast<int>(sfm.photos.photos.size());
   const bool refine_principal_point =
-      sfm.camera.single_camera && !sfm.camera.fixed_intrinsics &&
+      sfm.camera.sharing == CameraSharing::kAll && !sfm.camera.fixed_intrinsics &&
       num_images >= sfm.options.refine_principal_point_min_images;
   Stage stage;
   stage.name = sfm.known ? "triangulate" : "mapper";

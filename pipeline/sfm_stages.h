@@ -16,13 +16,23 @@
 
 namespace parallax {
 
+// Which photos share one camera (one set of intrinsics) in COLMAP's database.
+enum class CameraSharing {
+  kAll,       // One camera for every photo.
+  kPerGroup,  // One camera per PhotoSet::CameraGroups group: per size and EXIF camera.
+  kPerPhoto,  // One camera each (a known model with a camera per image).
+};
+
 // The COLMAP image model the extractor starts from, and its parameters when they are fixed.
 struct CameraSetup {
   CameraModel model;
   std::string params;  // Empty: COLMAP estimates them, from EXIF or the image size.
-  bool single_camera;
+  CameraSharing sharing;
   bool fixed_intrinsics;
 };
+
+// report.json's words for the camera setup, e.g. "SIMPLE_RADIAL, one shared camera".
+std::string DescribeCameraSetup(const CameraSetup& camera, const PhotoSet& photos);
 
 // The camera model and intrinsics SfM starts from: the known model's, the given intrinsics
 // (fixed), or `options.camera_model` estimated. Throws BadInputError for --intrinsics f on

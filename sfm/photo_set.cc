@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <tuple>
 
 #include <OpenImageIO/imageio.h>
 #include <tbb/parallel_for.h>
@@ -43,6 +44,8 @@ std::string ConversionNeeded(const OIIO::ImageSpec& spec, const std::string& for
   return text;
 }
 
+}  // namespace
+
 // Decodes the whole file: a truncated image often has an intact header.
 std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   std::string bytes;
@@ -75,6 +78,9 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
                   kMaxImageMegapixels);
     return std::string(reason);
   }
+  const std::string make = spec.get_string_attribute("Make");
+  const std::string model = spec.get_string_attribute("Model");
+  photo.exif_camera = make + (make.empty() || model.empty() ? "" : " ") + model;
   const float focal_35mm = spec.get_float_attribute("Exif:FocalLengthIn35mmFilm", 0.0f);
   if (focal_35mm > 0) {
     photo.exif_focal_px = static_cast<double>(focal_35mm) / 36.0 * std::max(spec.width, spec.height);
@@ -86,14 +92,19 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   return std::nullopt;
 }
 
-}  // namespace
 
-bool PhotoSet::SharesOneCamera() const {
-  return std::all_of(photos.begin(), photos.end(), [&](const Photo& photo) {
-    return photo.width == photos.front().width &&
-           photo.height == photos.front().height &&
-           photo.exif_focal_px == photos.front().exif_focal_px;
-  });
+std::vector<std::vector<size_t>> PhotoSet::CameraGroups() const {
+  using Key = std::tuple<int, int, std::optional<double>, std::string>;
+  std::map<Key, size_t> group_of_key;
+  std::vector<std::vector<size_t>> groups;
+  for (size_t i = 0; i < photos.size(); ++i) {
+    const Photo& photo = photos[i];
+    const Key key{photo.width, photo.height, photo.exif_focal_px, photo.exif_camera};
+    const auto [group, added] = group_of_key.emplace(key, groups.size());
+    if (added) groups.emplace_back();
+    groups[group->second].push_back(i);
+  }
+  return groups;
 }
 
 double PhotoSet::FocalPrior(const Photo& photo) const {

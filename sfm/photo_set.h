@@ -14,6 +14,7 @@ struct Photo {
   int width = 0;
   int height = 0;
   std::optional<double> exif_focal_px;  // From the 35 mm-equivalent focal length, if present.
+  std::string exif_camera;              // EXIF Make and Model, "" when absent.
   uint64_t content_hash = 0;
   // Why COLMAP cannot read the file as it is ("16-bit", "grayscale", ...), so that it is
   // converted (sfm/photo_conversion.h); empty: the file is used as it is.
@@ -29,10 +30,11 @@ struct PhotoSet {
   std::vector<Photo> photos;  // Sorted by name (COLMAP's order).
   std::vector<SkippedFile> skipped;
 
-  // True when every photo has the same size and the same EXIF focal length (or none has one),
-  // so one camera can serve them all: it is better constrained than one camera per photo (the
-  // 12 small example photos do not register at all with a camera each).
-  bool SharesOneCamera() const;
+  // The photos one camera can serve, as indices into `photos` in name order: those of one
+  // size, EXIF focal length and EXIF camera. A shared camera is better constrained than one
+  // per photo (the 12 small example photos do not register at all with a camera each).
+  std::vector<std::vector<size_t>> CameraGroups() const;
+  bool SharesOneCamera() const { return CameraGroups().size() == 1; }
   // The focal length SfM starts from: EXIF when present, else COLMAP's default 1.2 * max(w, h).
   double FocalPrior(const Photo& photo) const;
   // Hash of every name and content: changes when any photo changes.
@@ -40,6 +42,10 @@ struct PhotoSet {
   // True when any photo must be converted before COLMAP reads it.
   bool NeedsConversion() const;
 };
+
+// Checks one photo as ScanPhotos does, decoding it whole: fills `photo`'s size, EXIF fields,
+// content hash and conversion (not its name). Returns why it cannot be used, if it cannot.
+std::optional<std::string> CheckPhoto(const std::filesystem::path& path, Photo& photo);
 
 // Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.
 // Unreadable, corrupt or non-image files, formats other than JPEG, PNG, TIFF and BMP, images

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/image.h"
+#include "core/sparse_model.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 
@@ -200,6 +201,35 @@ TEST(ReconstructCli, PhotosInEveryFormACameraWritesAreReconstructed) {
   // A second run converts nothing again.
   const CliResult again = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast --dry-run"));
   EXPECT_NE(again.output.find("photos       skip"), std::string::npos) << again.output;
+}
+
+// Half the photos resized (another camera, or an editor's export): one camera per size, each
+// with the focal length of its size, instead of one per photo.
+TEST(ReconstructCli, PhotosOfTwoSizesGetOneCameraPerSize) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "two sizes";
+  fs::create_directories(photos);
+  for (int i = 0; i < 24; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.png", i);
+    OIIO::ImageBuf image((kCourtyardImages / name).string());
+    if (i % 2) image = OIIO::ImageBufAlgo::resize(image, "", 0, OIIO::ROI(0, 480, 0, 360));
+    ASSERT_TRUE(image.write((photos / name).string())) << image.geterror();
+  }
+  const fs::path workspace = dir.Path() / "ws";
+  const CliResult result = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("registered 24/24 photos"), std::string::npos) << result.output;
+  std::ifstream report_file(workspace / "report.json");
+  EXPECT_NE(nlohmann::json::parse(report_file)["reconstruct"]["camera_model"].get<std::string>().find("(2 cameras)"),
+            std::string::npos);
+  const SparseModel model = ReadSparseModel(workspace / "sparse");
+  ASSERT_EQ(model.Cameras().size(), 2u);
+  for (const Camera& camera : model.Cameras()) {
+    // The courtyard was rendered with a 520 px focal length at 640 px wide.
+    const double true_focal = 520.0 * static_cast<double>(camera.width) / 640.0;
+    EXPECT_NEAR(camera.params[0], true_focal, 0.02 * true_focal) << camera.width << "x" << camera.height;
+  }
 }
 
 // One photo re-encoded, brightened and blurred: copies no hash catches, with no baseline.

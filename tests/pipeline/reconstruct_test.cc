@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include <gtest/gtest.h>
+#include <OpenImageIO/imagebuf.h>
 
 #include "core/depth_map.h"
 #include "core/error.h"
@@ -124,6 +125,15 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   const Rigid3d& original = model.FindImageByName("0003.png")->cam_from_world;
   EXPECT_LT(RotationAngleDeg(twin.rotation, original.rotation), 0.05);
   EXPECT_LT((CameraCenter(twin) - CameraCenter(original)).norm(), 0.002 * evaluation.extent);
+  // A held-out photo colmap cannot read as it is (16-bit TIFF: FreeImage refuses it) is
+  // converted for the registration.
+  const TempDir tiff_dir;
+  ASSERT_TRUE(OIIO::ImageBuf((scene.Training().images / "0003.png").string())
+                  .write((tiff_dir.Path() / "0003.tif").string(), OIIO::TypeDesc::UINT16));
+  const HeldOutRegistration tiff = RegisterHeldOutPhotos(workspace.Path(), tiff_dir.Path(), {"0003.tif"},
+                                                         workspace.Path() / "tiff", progress);
+  ASSERT_TRUE(tiff.cam_from_world.contains("0003.tif")) << tiff.note;
+  EXPECT_LT(RotationAngleDeg(tiff.cam_from_world.at("0003.tif").rotation, original.rotation), 0.05);
 
   // Real photos come with cameras and held-out photos but no depth: everything else is scored,
   // and what is not is said.

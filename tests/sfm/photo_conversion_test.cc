@@ -87,6 +87,38 @@ TEST(PhotoConversion, FormsColmapCannotReadAreFlaggedAndTheOthersAreNot) {
   EXPECT_TRUE(set.NeedsConversion());
 }
 
+// One camera per size, EXIF camera and EXIF focal length (pipeline/sfm_stages.h CameraSharing).
+TEST(PhotoSet, PhotosAreGroupedByCameraAndFocalLength) {
+  const TempDir dir;
+  float shade = 0;  // Sets one pixel apart in each: identical copies would be skipped.
+  const auto write = [&](const std::string& name, const std::string& make, int focal_35mm) {
+    OIIO::ImageBuf image = Gradient();
+    shade += 0.15f;
+    const float pixel[3] = {shade, shade, shade};
+    image.setpixel(0, 0, pixel);
+    if (!make.empty()) {
+      image.specmod().attribute("Make", make);
+      image.specmod().attribute("Model", "X1");
+      image.specmod().attribute("Exif:FocalLengthIn35mmFilm", focal_35mm);
+    }
+    ASSERT_TRUE(image.write((dir.Path() / name).string())) << image.geterror();
+  };
+  write("a.jpg", "Canon", 28);
+  write("b.jpg", "Canon", 28);
+  write("c.jpg", "Nikon", 28);
+  write("d.jpg", "Canon", 50);
+  write("e.jpg", "", 0);
+  write("f.png", "", 0);
+  const PhotoSet set = ScanPhotos(dir.Path());
+  ASSERT_EQ(set.photos.size(), 6u);
+  EXPECT_EQ(set.photos[0].exif_camera, "Canon X1");
+  ASSERT_TRUE(set.photos[3].exif_focal_px.has_value());
+  EXPECT_NEAR(*set.photos[3].exif_focal_px, 50.0 / 36.0 * 40, 1e-9);
+  const std::vector<std::vector<size_t>> expected = {{0, 1}, {2}, {3}, {4, 5}};
+  EXPECT_EQ(set.CameraGroups(), expected);
+  EXPECT_FALSE(set.SharesOneCamera());
+}
+
 TEST(PhotoConversion, WritesUprightEightBitRgbInTheFormatTheNameSays) {
   const TempDir dir;
   const OIIO::ImageBuf gradient = Gradient();
