@@ -34,6 +34,10 @@ class Workspace {
   std::filesystem::path StereoEstimate(const std::string& photo) const {
     return StereoEstimates() / (photo + ".bin");
   }
+  // A view's report once its geometric pass wrote its depth maps: stereo/estimates/<photo>.json.
+  std::filesystem::path StereoViewReport(const std::string& photo) const {
+    return StereoEstimates() / (photo + ".json");
+  }
 
   // Structure from motion's own files: the COLMAP database, the raw (distorted) models.
   std::filesystem::path Sfm() const { return root_ / "sfm"; }

@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "core/atomic_file.h"
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "core/image.h"
@@ -246,7 +247,7 @@ DepthNormalMap ReadEstimate(const std::filesystem::path& path) {
   return estimate;
 }
 
-// PatchMatch on every planned view, each estimate written to <ws>/stereo/estimates.
+// PatchMatch on each of `plans` whose estimate is not in <ws>/stereo/estimates yet.
 void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const std::vector<ViewPlan>& plans,
                          const MvsOptions& options, Progress& progress) {
   std::map<uint32_t, StereoView> views;
@@ -254,6 +255,7 @@ void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const st
   for (size_t i = 0; i < plans.size(); ++i) {
     progress.Update("depth", static_cast<int64_t>(i), total);
     const ViewPlan& plan = plans[i];
+    if (fs::exists(ws.StereoEstimate(plan.name))) continue;
     views = LoadStereoViews(ws, model, plan, options, views);
     std::vector<const StereoView*> sources;
     for (uint32_t id : plan.sources) sources.push_back(&views.at(id));
@@ -332,30 +334,65 @@ MvsViewReport FilterAndWriteView(const Workspace& ws, const SparseModel& model, 
 
 MvsSummary RunMultiViewStereo(const fs::path& workspace, const MvsOptions& options,
                               Progress& progress) {
+  const Workspace ws(workspace);
+  fs::remove_all(ws.StereoEstimates());
+  auto start = std::chrono::steady_clock::now();
+  RunMultiViewStereoBlock(workspace, options, {MvsPass::kPhotometric}, progress);
+  const double photometric_seconds = Seconds(start);
+  start = std::chrono::steady_clock::now();
+  RunMultiViewStereoBlock(workspace, options, {MvsPass::kGeometric}, progress);
+  MvsSummary summary = FinishMultiViewStereoBlocks(workspace, options);
+  summary.photometric_seconds = photometric_seconds;
+  summary.geometric_seconds = Seconds(start);
+  return summary;
+}
+
+int RunMultiViewStereoBlock(const fs::path& workspace, const MvsOptions& options, const MvsBlock& block,
+                            Progress& progress) {
   options.Check();
+  const Workspace ws(workspace);
+  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const DepthPlan plan = PlanDepth(model, options, workspace);
+  const bool photometric = block.pass == MvsPass::kPhotometric;
+  const std::vector<ViewPlan>& views = photometric ? plan.estimated : plan.written;
+  const size_t size = block.size > 0 ? static_cast<size_t>(block.size) : views.size();
+  const size_t first = std::min(views.size(), static_cast<size_t>(block.index) * size);
+  const std::vector<ViewPlan> in_block(views.begin() + static_cast<std::ptrdiff_t>(first),
+                                       views.begin() + static_cast<std::ptrdiff_t>(std::min(views.size(), first + size)));
+  fs::create_directories(ws.StereoEstimates());
+  if (photometric) {
+    EstimatePhotometric(ws, model, in_block, options, progress);
+    return static_cast<int>(in_block.size());
+  }
+  std::set<std::string> estimated;
+  for (const ViewPlan& view : plan.estimated) estimated.insert(view.name);
+  const auto total = static_cast<int64_t>(in_block.size());
+  for (size_t i = 0; i < in_block.size(); ++i) {
+    progress.Update("filter", static_cast<int64_t>(i), total);
+    const fs::path report = ws.StereoViewReport(in_block[i].name);
+    if (fs::exists(report)) continue;
+    const MvsViewReport written = FilterAndWriteView(ws, model, in_block[i], estimated, options);
+    WriteFileAtomically(report, nlohmann::json(written).dump() + "\n");
+  }
+  progress.Update("filter", total, total);
+  return static_cast<int>(in_block.size());
+}
+
+MvsSummary FinishMultiViewStereoBlocks(const fs::path& workspace, const MvsOptions& options) {
   const Workspace ws(workspace);
   const SparseModel model = ReadSparseModel(ws.Sparse());
   const DepthPlan plan = PlanDepth(model, options, workspace);
   MvsSummary summary;
   summary.estimated_views = static_cast<int>(plan.estimated.size());
   summary.skipped = SkippedViews(model, plan);
-  fs::remove_all(ws.StereoEstimates());
-  fs::create_directories(ws.StereoEstimates());
-
-  auto start = std::chrono::steady_clock::now();
-  EstimatePhotometric(ws, model, plan.estimated, options, progress);
-  summary.photometric_seconds = Seconds(start);
-
-  start = std::chrono::steady_clock::now();
-  std::set<std::string> estimated;
-  for (const ViewPlan& view : plan.estimated) estimated.insert(view.name);
-  const auto total = static_cast<int64_t>(plan.written.size());
-  for (size_t i = 0; i < plan.written.size(); ++i) {
-    progress.Update("filter", static_cast<int64_t>(i), total);
-    summary.views.push_back(FilterAndWriteView(ws, model, plan.written[i], estimated, options));
+  for (const ViewPlan& view : plan.written) {
+    const fs::path report = ws.StereoViewReport(view.name);
+    if (!fs::exists(report)) {
+      throw BadInputError("the depth of " + view.name + " is not done (no " + report.string() +
+                          "): a geometric block did not run or failed");
+    }
+    summary.views.push_back(nlohmann::json::parse(ReadFileBytes(report)).get<MvsViewReport>());
   }
-  progress.Update("filter", total, total);
-  summary.geometric_seconds = Seconds(start);
   fs::remove_all(ws.StereoEstimates());
   return summary;
 }

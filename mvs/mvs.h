@@ -76,8 +76,31 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsSummary, views, skipped, phot
                                                 geometric_seconds)
 
 // Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
+// The same as every block of both passes, then FinishMultiViewStereoBlocks.
 MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,
                               Progress& progress);
+
+// The depth stage in parts that separate processes (cluster jobs, pipeline/slurm.h) can run:
+// block `index` of `size` consecutive views of one pass (size 0: every view). Every
+// photometric block must be done before a geometric block starts, since a view is checked
+// against its sources' estimates.
+enum class MvsPass { kPhotometric, kGeometric };
+struct MvsBlock {
+  MvsPass pass;
+  int index = 0;
+  int size = 0;
+};
+
+// Runs one block. Photometric: PatchMatch, each view's estimate to <ws>/stereo/estimates;
+// geometric: the filter, each view's depth maps, then its report beside the estimates. A view
+// whose estimate (or report) exists is not computed again, so a resubmitted job redoes only
+// what is missing. Returns the number of views in the block (0: past the last one).
+int RunMultiViewStereoBlock(const std::filesystem::path& workspace, const MvsOptions& options,
+                            const MvsBlock& block, Progress& progress);
+
+// Once every block ran: the summary from the views' reports (seconds left 0), and the
+// estimates removed. Throws BadInputError naming a view whose report is missing.
+MvsSummary FinishMultiViewStereoBlocks(const std::filesystem::path& workspace, const MvsOptions& options);
 
 // Depth at pixel centres (our convention) -> depth sampled at integer image points (x, y), as
 // COLMAP's dense code reads its maps: inverse depth averaged over the four surrounding pixel
