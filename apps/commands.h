@@ -10,6 +10,7 @@ void RegisterReconstructCommand(CLI::App& app);
 void RegisterEvaluateCommand(CLI::App& app);
 void RegisterRenderCommand(CLI::App& app);
 void RegisterBenchCommand(CLI::App& app);
+void RegisterDepthBlockCommand(CLI::App& app);
 void RegisterViewCommand(CLI::App& app);
 
 }  // namespace parallax

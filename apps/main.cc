@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
   RegisterEvaluateCommand(app);
   RegisterViewCommand(app);
   RegisterBenchCommand(app);
+  RegisterDepthBlockCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

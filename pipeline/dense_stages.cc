@@ -44,6 +44,16 @@ std::string ScaleKey(const Workspace& workspace, const MvsOptions& options) {
 
 }  // namespace
 
+DepthRequest DepthRequestOf(const ReconstructOptions& options) {
+  DepthRequest request;
+  request.quality = options.quality;
+  request.stereo = options.stereo;
+  request.sources = options.mvs_sources;
+  request.scale = options.mvs_scale;
+  request.max_size = options.mvs_max_size;
+  return request;
+}
+
 MvsOptions MvsOptionsOf(const DepthRequest& request) {
   MvsOptions options = MvsOptionsFor(request.quality);
   if (request.sources > 0) options.views.max_sources = request.sources;
@@ -99,7 +109,8 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
   }
   stage.run = [workspace, request, every_view, summary, &progress] {
     const MvsOptions options = MvsOptionsOf(request);
-    const MvsSummary mvs = request.stereo == StereoMethod::kSgbm
+    const MvsSummary mvs = request.collect_blocks ? FinishMultiViewStereoBlocks(workspace.Root(), options)
+                           : request.stereo == StereoMethod::kSgbm
                                ? RunSgbmStereo(workspace.Root(), options.views, {}, progress)
                                : RunMultiViewStereo(workspace.Root(), options, progress);
     if (every_view) WriteFileAtomically(workspace.DepthViews(), nlohmann::json(mvs).dump(2) + "\n");

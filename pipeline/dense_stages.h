@@ -25,7 +25,15 @@ struct DepthRequest {
   int max_size = 0;
   // Only these views (image names); empty: every view, and depth/views.json is written.
   std::vector<std::string> views;
+  // The views were estimated in blocks by other processes (RunMultiViewStereoBlock): the
+  // stage only collects them. Not part of the key: the maps are the same.
+  bool collect_blocks = false;
 };
+
+// The depth `reconstruct` asks for with `options`.
+DepthRequest DepthRequestOf(const ReconstructOptions& options);
+// As <ws>/slurm/depth_request.json keeps it for the cluster's jobs (pipeline/slurm.h).
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DepthRequest, quality, stereo, sources, scale, max_size)
 
 // The stereo's options for `request`.
 MvsOptions MvsOptionsOf(const DepthRequest& request);

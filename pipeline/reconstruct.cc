@@ -161,16 +161,6 @@ SparseModel CheckRawModel(const SfmContext& sfm, ReconstructSummary& summary) {
   return raw_model;
 }
 
-DepthRequest DepthRequestOf(const ReconstructOptions& options) {
-  DepthRequest request;
-  request.quality = options.quality;
-  request.stereo = options.stereo;
-  request.sources = options.mvs_sources;
-  request.scale = options.mvs_scale;
-  request.max_size = options.mvs_max_size;
-  return request;
-}
-
 std::vector<std::string> DescribeDepthResolutions(const DepthRequest& request,
                                                   const std::set<std::pair<int, int>>& sizes) {
   std::vector<std::string> descriptions;

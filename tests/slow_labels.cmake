@@ -2,3 +2,4 @@
 set_tests_properties(${bench_test_TESTS} PROPERTIES LABELS "bench;slow")
 set_tests_properties(ReconstructCli.PhotosInEveryFormACameraWritesAreReconstructed PROPERTIES LABELS "cli;slow")
 set_tests_properties(ReconstructCli.PhotosOfTwoSizesGetOneCameraPerSize PROPERTIES LABELS "cli;slow")
+set_tests_properties(Slurm.JobArraysOnARealClusterWriteWhatALocalRunWrites PROPERTIES LABELS "cli;slow")
