@@ -203,10 +203,11 @@ std::string ViewName(const std::string& prefix, size_t index) {
   return name;
 }
 
-// Appends the cameras of one rig entry: a full ring, an arc, or explicit poses.
+// Appends the cameras of one rig entry: a full ring (or a helix of several turns), an arc, or
+// explicit poses.
 void ParseRig(const Node& node, const std::string& prefix, std::vector<ViewDesc>& views) {
-  node.AllowOnly({"rig", "count", "radius", "height", "center", "look_at", "start_deg",
-                  "end_deg", "poses"});
+  node.AllowOnly({"rig", "count", "radius", "height", "end_height", "turns", "center", "look_at",
+                  "start_deg", "end_deg", "poses"});
   const std::string rig = node.String("rig", "");
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   auto add = [&](const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
@@ -232,14 +233,22 @@ void ParseRig(const Node& node, const std::string& prefix, std::vector<ViewDesc>
   const Eigen::Vector3d center = node.Vec3("center", Eigen::Vector3d::Zero());
   const Eigen::Vector3d look_at = node.Vec3("look_at", center);
   const double start_deg = node.Number("start_deg", 0, -3600, 3600);
-  // A ring spaces `count` cameras over 360 degrees; an arc puts its ends on start and end.
+  // A ring spaces `count` cameras evenly over `turns` turns, rising linearly from `height`
+  // towards `end_height`, which the camera after the last would reach (so every k-th camera of
+  // a ring is the ring of count / k); an arc puts its ends on start and end.
+  if (rig == "arc" && (node.Has("turns") || node.Has("end_height"))) {
+    node.Fail("'turns' and 'end_height' belong to a ring, not an arc");
+  }
+  const double turns = node.Number("turns", 1, 0.01, 100);
+  const double end_height = node.Number("end_height", height, -1e9, 1e9);
   const double end_deg = node.Number("end_deg", start_deg + 360, -3600, 3600);
-  const double step_deg = rig == "ring" ? 360.0 / count
+  const double step_deg = rig == "ring" ? 360.0 * turns / count
                                         : (count > 1 ? (end_deg - start_deg) / (count - 1) : 0);
   for (int i = 0; i < count; ++i) {
     const double angle = (start_deg + i * step_deg) * std::numbers::pi / 180;
+    const double eye_height = height + (end_height - height) * i / count;
     const Eigen::Vector3d eye =
-        center + Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), height);
+        center + Eigen::Vector3d(radius * std::cos(angle), radius * std::sin(angle), eye_height);
     add(eye, look_at);
   }
 }

@@ -1,5 +1,8 @@
 #include "synth/scene.h"
 
+#include <cmath>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "core/error.h"
@@ -31,6 +34,40 @@ TEST(SceneJson, MinimalSceneGetsDocumentedDefaults) {
   // Ring cameras sit at the given radius and height, looking at the ring centre.
   EXPECT_NEAR(CameraCenter(scene.training[1].cam_from_world).head<2>().norm(), 3, 1e-12);
   EXPECT_NEAR(CameraCenter(scene.training[1].cam_from_world).z(), 1, 1e-12);
+}
+
+// kMinimal with `rig` as its training cameras.
+std::string SceneWithRig(const std::string& rig) {
+  return R"({"materials": {"m": {}},
+             "objects": [{"type": "sphere", "material": "m", "center": [0, 0, 1], "radius": 0.5}],
+             "cameras": {"training": [)" + rig + "]}}";
+}
+
+SceneDesc HelixScene(int count) {
+  return ParseSceneJson(SceneWithRig(R"({"rig": "ring", "count": )" + std::to_string(count) +
+                                     R"(, "radius": 3, "height": 1, "end_height": 3, "turns": 2,
+                                        "start_deg": 10})"),
+                        "scene.json");
+}
+
+TEST(SceneJson, EveryKthCameraOfAHelixIsTheHelixOfFewerCameras) {
+  const SceneDesc dense = HelixScene(40);
+  const SceneDesc sparse = HelixScene(10);
+  ASSERT_EQ(sparse.training.size(), 10u);
+  for (size_t i = 0; i < sparse.training.size(); ++i) {
+    const Eigen::Vector3d expected = CameraCenter(dense.training[4 * i].cam_from_world);
+    EXPECT_LT((CameraCenter(sparse.training[i].cam_from_world) - expected).norm(), 1e-9) << i;
+  }
+  // Two turns rising from 1 towards 3: camera 20 of 40 is back at the start angle, at 2.
+  const Eigen::Vector3d start = CameraCenter(dense.training[0].cam_from_world);
+  const Eigen::Vector3d half = CameraCenter(dense.training[20].cam_from_world);
+  EXPECT_NEAR(start.z(), 1, 1e-12);
+  EXPECT_NEAR(half.z(), 2, 1e-12);
+  EXPECT_LT((half.head<2>() - start.head<2>()).norm(), 1e-9);
+  EXPECT_NEAR(std::atan2(start.y(), start.x()) * 180 / 3.14159265358979, 10, 1e-9);
+  EXPECT_NE(ErrorOf(SceneWithRig(R"({"rig": "arc", "count": 2, "radius": 1, "turns": 2})"))
+                .find("belong to a ring"),
+            std::string::npos);
 }
 
 TEST(SceneJson, SyntaxErrorsNameTheFileLineAndColumn) {
