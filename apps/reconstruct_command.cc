@@ -119,10 +119,15 @@ void RegisterReconstructCommand(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(qualities, CLI::ignore_case));
   const std::map<std::string, MatcherChoice> matchers = {{"auto", MatcherChoice::kAuto},
                                                          {"exhaustive", MatcherChoice::kExhaustive},
-                                                         {"sequential", MatcherChoice::kSequential}};
+                                                         {"sequential", MatcherChoice::kSequential},
+                                                         {"retrieval", MatcherChoice::kRetrieval}};
   command->add_option("--matcher", arguments->options.matcher,
-                      "auto (default): exhaustive up to 300 photos, else sequential with the "
-                      "ends matched for loop closure")
+                      "auto (default): exhaustive (every pair) up to " +
+                          std::to_string(ReconstructOptions().exhaustive_limit) +
+                          " photos; past that sequential (name-order neighbours, loops closed "
+                          "by retrieval) when consecutive photos match, else retrieval (each "
+                          "photo with its most similar, from a vocabulary tree built from the "
+                          "photos)")
       ->transform(CLI::CheckedTransformer(matchers, CLI::ignore_case));
   command->add_option("--camera-model", arguments->camera_model,
                       "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");

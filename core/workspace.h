@@ -49,7 +49,7 @@ class Workspace {
   std::filesystem::path Models() const { return Sfm() / "models"; }
   std::filesystem::path RawModel() const { return Sfm() / "sparse"; }
   std::filesystem::path MatchedMarker() const { return Sfm() / "matched"; }
-  std::filesystem::path LoopPairs() const { return Sfm() / "loop_pairs.txt"; }
+  std::filesystem::path VocabularyTree() const { return Sfm() / "vocab_tree.bin"; }
   std::filesystem::path RefinedModelScratch() const { return Sfm() / "refined.tmp"; }
 
   // Depth maps at each photo's size: depth/<stem>.exr and depth/<stem>.confidence.exr.

@@ -215,7 +215,10 @@ void ReconstructOptions::Check() const {
                                 " is not supported");
   }
   RequireOption(exhaustive_limit >= 2, "ReconstructOptions.exhaustive_limit", exhaustive_limit, ">= 2");
-  RequireOption(sequential_overlap >= 1, "ReconstructOptions.sequential_overlap", sequential_overlap, ">= 1");
+  RequireOption(sequential_overlap >= 2, "ReconstructOptions.sequential_overlap", sequential_overlap, ">= 2");
+  RequireOption(retrieval_images >= 1, "ReconstructOptions.retrieval_images", retrieval_images, ">= 1");
+  RequireOption(ordered_share > 0 && ordered_share <= 1, "ReconstructOptions.ordered_share", ordered_share,
+                "in (0, 1]");
   RequireOption(refine_principal_point_min_images >= 1, "ReconstructOptions.refine_principal_point_min_images",
                 refine_principal_point_min_images, ">= 1");
   RequireOption(max_refined_principal_point_offset > 0, "ReconstructOptions.max_refined_principal_point_offset",
@@ -252,13 +255,12 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     summary.warnings.push_back("skipped " + file.name + ": it " + file.reason);
   }
   const int num_images = summary.images_found;
-  const bool sequential = UseSequentialMatcher(options, num_images);
   const Workspace paths(workspace);
   const SfmContext sfm{ReadablePhotosDir(photos_dir, photos, paths), photos, known ? &*known : nullptr, options, colmap,
                        paths, ChooseCameraSetup(photos, options, known ? &*known : nullptr),
-                       sequential, progress};
+                       MatcherFor(options, num_images), progress};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
-  summary.matcher = DescribeMatcher(options, num_images, sequential);
+  summary.matcher = PlannedMatcher(options, num_images);
 
   const std::string conversions = DescribeConversions(photos, paths);
   if (!conversions.empty()) summary.notes.push_back(conversions);
@@ -268,8 +270,14 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   graph.Run(converted);
   const Stage features = FeaturesStage(sfm, converted.key);
   graph.Run(features);
-  const Stage matches = MatchesStage(sfm, features.key);
+  const Stage vocabulary_tree = VocabularyTreeStage(sfm, features.key);
+  graph.Run(vocabulary_tree);
+  const Stage matches = MatchesStage(sfm, features.key, vocabulary_tree.key);
   graph.Run(matches);
+  // The marker says which matcher ran and why (older workspaces' markers hold only the key).
+  if (!options.dry_run && ReadFileBytes(paths.MatchedMarker()) != matches.key) {
+    summary.matcher = ReadFileBytes(paths.MatchedMarker());
+  }
   const Stage mapper = MapperStage(sfm, matches.key, summary.notes);
   graph.Run(mapper);
   if (options.dry_run) {

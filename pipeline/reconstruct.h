@@ -22,10 +22,14 @@ namespace parallax {
 // SfM at each Quality: fast: images up to 1024 px, 2048 features; balanced: 2000 px, 4096
 // features; best: 3200 px, 8192 features and guided matching.
 
+// How photos are paired for feature matching. Sequential and retrieval use a vocabulary tree
+// that parallax builds from the photos' own features (no tree file is needed).
 enum class MatcherChoice {
-  kAuto,        // Exhaustive up to `exhaustive_limit` images, else sequential.
+  kAuto,        // Exhaustive up to `exhaustive_limit` images; past it, sequential when photos
+                // consecutive in name order match each other (an ordered capture), else retrieval.
   kExhaustive,  // Every pair.
-  kSequential,  // Neighbours in name order, plus the ends of the sequence (loop closure).
+  kSequential,  // Neighbours in name order, loops closed by retrieval every few images.
+  kRetrieval,   // Each image with the images most similar to it in the vocabulary tree.
 };
 
 enum class StereoMethod { kPatchMatch, kSgbm };
@@ -46,10 +50,17 @@ struct ReconstructOptions {
   bool dry_run = false;
   // colmap executable (name on PATH or path).
   std::string colmap = "colmap";
-  // Above this many images the automatic matcher is sequential.
+  // Above this many images the automatic matcher is sequential or retrieval (docs/scale.md:
+  // where exhaustive matching starts to cost more than they do, measured).
   int exhaustive_limit = 300;
-  // Neighbours matched on each side by the sequential matcher.
+  // colmap's SequentialMatching.overlap: each image is matched with the next overlap - 1
+  // images in name order (and those a power of two ahead).
   int sequential_overlap = 20;
+  // Most similar images each image is matched with by retrieval.
+  int retrieval_images = 40;
+  // Share of consecutive photos (name order) that must match for the automatic matcher to
+  // treat the capture as ordered.
+  double ordered_share = 0.8;
   // A camera shared by at least this many photos gets its principal point refined in a final
   // bundle adjustment (COLMAP keeps it at the image centre, which skews the rotations of
   // photos whose principal point is off-centre).

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <set>
+#include <utility>
 #include <sstream>
 
 #include <tbb/parallel_for.h>
@@ -42,6 +44,99 @@ QualitySettings SettingsFor(Quality quality) {
   }
   throw std::invalid_argument("unknown quality");
 }
+
+// COLMAP publishes trees of 32K words for sets of up to about 1,000 images. parallax builds
+// one from the features of at most 30 of the photos: colmap's k-means costs about 100 s of CPU
+// for 24 photos' features already, and the cost would grow with the set.
+constexpr int kVocabularyTreeWords = 32768;
+constexpr int kVocabularyTreeTrainingImages = 30;
+
+std::string Percent(double share) {
+  char text[16];
+  std::snprintf(text, sizeof(text), "%.0f%%", 100 * share);
+  return text;
+}
+
+// report.json's sentence for the matcher that ran, `why` it was chosen when automatically.
+std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& options,
+                            int num_images, std::string why) {
+  std::string text;
+  switch (matcher) {
+    case MatcherChoice::kExhaustive:
+      text = "exhaustive (" + std::to_string(num_images) + " images, every pair)";
+      if (options.matcher == MatcherChoice::kAuto) {
+        why = "chosen automatically: at most " + std::to_string(options.exhaustive_limit) +
+              " images";
+      }
+      break;
+    case MatcherChoice::kSequential:
+      text = "sequential (each image with the next " +
+             std::to_string(options.sequential_overlap - 1) +
+             " in name order and those a power of two ahead; loops closed by retrieval from a "
+             "vocabulary tree built from these photos)";
+      break;
+    case MatcherChoice::kRetrieval:
+      text = "retrieval (each image with its " + std::to_string(options.retrieval_images) +
+             " most similar in a vocabulary tree built from these photos)";
+      break;
+    case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
+  }
+  return why.empty() ? text : text + ", " + why;
+}
+
+// One run of the matches stage: colmap's matchers on the database being written.
+struct Matching {
+  const SfmContext& sfm;
+  fs::path database;
+  std::vector<std::string> common;  // Database and matching options every matcher takes.
+
+  // Matches each photo with the next in name order and returns the share of those pairs that
+  // verified. The pairs stay in the database; the matchers after skip them.
+  double ConsecutiveShare() const {
+    std::vector<std::string> arguments = common;
+    // colmap's overlap counts the image itself: 2 pairs it with the next one only.
+    arguments.insert(arguments.end(), {"--SequentialMatching.overlap", "2",
+                                       "--SequentialMatching.quadratic_overlap", "0"});
+    Run("sequential_matcher", arguments, "matches, consecutive photos");
+    std::set<std::pair<std::string, std::string>> verified;
+    for (const VerifiedPair& pair : ReadVerifiedPairs(database)) {
+      verified.insert(std::minmax(pair.first, pair.second));
+    }
+    const std::vector<Photo>& photos = sfm.photos.photos;
+    int consecutive = 0;
+    for (size_t i = 0; i + 1 < photos.size(); ++i) {
+      consecutive += static_cast<int>(verified.count(std::minmax(photos[i].name, photos[i + 1].name)));
+    }
+    return photos.size() < 2 ? 0 : static_cast<double>(consecutive) / static_cast<double>(photos.size() - 1);
+  }
+
+  void Run(MatcherChoice matcher) const {
+    std::vector<std::string> arguments = common;
+    const std::string tree = sfm.workspace.VocabularyTree().string();
+    const std::string neighbours = std::to_string(sfm.options.retrieval_images);
+    switch (matcher) {
+      case MatcherChoice::kExhaustive: return Run("exhaustive_matcher", arguments, "matches");
+      case MatcherChoice::kSequential:
+        arguments.insert(arguments.end(),
+                         {"--SequentialMatching.overlap", std::to_string(sfm.options.sequential_overlap),
+                          "--SequentialMatching.loop_detection", "1",
+                          "--SequentialMatching.loop_detection_num_images", neighbours,
+                          "--SequentialMatching.vocab_tree_path", tree});
+        return Run("sequential_matcher", arguments, "matches");
+      case MatcherChoice::kRetrieval:
+        arguments.insert(arguments.end(), {"--VocabTreeMatching.num_images", neighbours,
+                                           "--VocabTreeMatching.vocab_tree_path", tree});
+        return Run("vocab_tree_matcher", arguments, "matches");
+      case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
+    }
+  }
+
+  void Run(const std::string& command, const std::vector<std::string>& arguments,
+           const std::string& label) const {
+    sfm.colmap.Run(command, arguments, sfm.workspace.Log("matches"), label,
+                   static_cast<int>(sfm.photos.photos.size()), sfm.progress);
+  }
+};
 
 std::string Join(const std::vector<double>& values) {
   std::ostringstream text;
@@ -270,18 +365,21 @@ std::string DescribeCameraSetup(const CameraSetup& camera, const PhotoSet& photo
          (camera.fixed_intrinsics ? ", intrinsics fixed" : "");
 }
 
-bool UseSequentialMatcher(const ReconstructOptions& options, int num_images) {
-  return options.matcher == MatcherChoice::kSequential ||
-         (options.matcher == MatcherChoice::kAuto && num_images > options.exhaustive_limit);
+MatcherChoice MatcherFor(const ReconstructOptions& options, int num_images) {
+  if (options.matcher == MatcherChoice::kAuto && num_images <= options.exhaustive_limit) {
+    return MatcherChoice::kExhaustive;
+  }
+  return options.matcher;
 }
 
-std::string DescribeMatcher(const ReconstructOptions& options, int num_images, bool sequential) {
-  std::string matcher =
-      sequential ? "sequential (overlap " + std::to_string(options.sequential_overlap) +
-                       ", first and last images matched for loop closure)"
-                 : "exhaustive (" + std::to_string(num_images) + " images, every pair)";
-  if (options.matcher == MatcherChoice::kAuto) matcher += ", chosen automatically";
-  return matcher;
+std::string PlannedMatcher(const ReconstructOptions& options, int num_images) {
+  const MatcherChoice matcher = MatcherFor(options, num_images);
+  if (matcher == MatcherChoice::kAuto) {
+    return "sequential or retrieval, as the photos' name order says once consecutive photos are "
+           "matched (" + std::to_string(num_images) + " images, more than " +
+           std::to_string(options.exhaustive_limit) + " for exhaustive matching)";
+  }
+  return DescribeMatcher(matcher, options, num_images, "");
 }
 
 fs::path ReadablePhotosDir(const fs::path& photos_dir, const PhotoSet& photos,
@@ -398,54 +496,80 @@ Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key) {
   return stage;
 }
 
-Stage MatchesStage(const SfmContext& sfm, const std::string& features_key) {
+Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key) {
+  const Workspace& paths = sfm.workspace;
+  Stage stage;
+  stage.name = "vocabulary tree";
+  stage.key = Hasher()
+                  .Add(features_key)
+                  .Add("vocab-tree-1")
+                  .Add(static_cast<uint64_t>(kVocabularyTreeWords))
+                  .Add(static_cast<uint64_t>(kVocabularyTreeTrainingImages))
+                  .Hex();
+  if (sfm.matcher == MatcherChoice::kExhaustive) {
+    stage.not_needed = "exhaustive matching pairs every image without one";
+    stage.run = [] {};
+    return stage;
+  }
+  stage.outputs = {paths.VocabularyTree()};
+  stage.run = [&sfm, paths] {
+    const int num_images = static_cast<int>(sfm.photos.photos.size());
+    const fs::path tree = paths.VocabularyTree().string() + ".tmp";
+    const TemporaryOutput temporary(tree);
+    sfm.colmap.Run("vocab_tree_builder",
+                   {"--database_path", paths.Database().string(), "--vocab_tree_path",
+                    tree.string(), "--num_visual_words", std::to_string(kVocabularyTreeWords),
+                    "--max_num_images",  // colmap refuses more than there are.
+                    std::to_string(std::min(num_images, kVocabularyTreeTrainingImages))},
+                   paths.Log("vocabulary_tree"), "vocabulary tree", num_images, sfm.progress);
+    fs::rename(tree, paths.VocabularyTree());
+  };
+  return stage;
+}
+
+Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
+                   const std::string& vocabulary_tree_key) {
   const QualitySettings quality = SettingsFor(sfm.options.quality);
   const Workspace& paths = sfm.workspace;
   Stage stage;
   stage.name = "matches";
-  stage.key = Hasher()
-                  .Add(features_key)
-                  .Add(sfm.sequential)
-                  .Add(static_cast<uint64_t>(sfm.options.sequential_overlap))
-                  .Add(quality.guided_matching)
-                  .Hex();
+  Hasher hasher;
+  hasher.Add(features_key)
+      .Add(sfm.matcher != MatcherChoice::kExhaustive)
+      .Add(static_cast<uint64_t>(sfm.options.sequential_overlap))
+      .Add(quality.guided_matching);
+  // Exhaustive matching keeps the key it had before the other matchers came.
+  if (sfm.matcher != MatcherChoice::kExhaustive) {
+    hasher.Add(vocabulary_tree_key)
+        .Add(static_cast<uint64_t>(sfm.matcher))
+        .Add(static_cast<uint64_t>(sfm.options.retrieval_images))
+        .Add(sfm.options.ordered_share);
+  }
+  stage.key = hasher.Hex();
   stage.outputs = {paths.MatchedMarker()};
-  stage.run = [&sfm, quality, paths, key = stage.key] {
+  stage.run = [&sfm, quality, paths] {
     const int num_images = static_cast<int>(sfm.photos.photos.size());
-    const int overlap = sfm.options.sequential_overlap;
     const fs::path database = paths.Database().string() + ".tmp";
     const TemporaryDatabase temporary(database);
     fs::copy_file(paths.Database(), database, fs::copy_options::overwrite_existing);
-    const std::vector<std::string> common = {
-        "--database_path", database.string(), "--SiftMatching.use_gpu", "0",
-        "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"};
-    if (sfm.sequential) {
-      std::vector<std::string> arguments = common;
-      arguments.insert(arguments.end(), {"--SequentialMatching.overlap", std::to_string(overlap),
-                                         "--SequentialMatching.loop_detection", "0"});
-      sfm.colmap.Run("sequential_matcher", arguments, paths.Log("matches"), "matches", num_images,
-                     sfm.progress);
-      // Without a vocabulary tree, a ring closes only if its ends are matched explicitly.
-      std::string pairs;
-      const int ends = std::min(overlap / 2 + 1, num_images / 2);
-      for (int i = 0; i < ends; ++i) {
-        for (int j = num_images - ends; j < num_images; ++j) {
-          pairs += sfm.photos.photos[static_cast<size_t>(i)].name + " " +
-                   sfm.photos.photos[static_cast<size_t>(j)].name + "\n";
-        }
-      }
-      WriteFileAtomically(paths.LoopPairs(), pairs);
-      arguments = common;
-      arguments.insert(arguments.end(), {"--match_list_path", paths.LoopPairs().string(),
-                                         "--match_type", "pairs"});
-      sfm.colmap.Run("matches_importer", arguments, paths.Log("matches"), "loop closure",
-                     num_images, sfm.progress);
-    } else {
-      sfm.colmap.Run("exhaustive_matcher", common, paths.Log("matches"), "matches", num_images,
-                     sfm.progress);
+    const Matching matching{sfm, database,
+                            {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
+                             "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"}};
+    MatcherChoice matcher = sfm.matcher;
+    std::string why;
+    if (matcher == MatcherChoice::kAuto) {
+      const double share = matching.ConsecutiveShare();
+      matcher = share >= sfm.options.ordered_share ? MatcherChoice::kSequential
+                                                   : MatcherChoice::kRetrieval;
+      why = "chosen automatically: " + std::to_string(num_images) + " images, more than " +
+            std::to_string(sfm.options.exhaustive_limit) + " for exhaustive matching, and " +
+            Percent(share) + " of the photos consecutive in name order match the next (" +
+            (matcher == MatcherChoice::kSequential ? "an ordered capture" : "not an ordered capture") +
+            ")";
     }
+    matching.Run(matcher);
     fs::rename(database, paths.Database());
-    WriteFileAtomically(paths.MatchedMarker(), key);
+    WriteFileAtomically(paths.MatchedMarker(), DescribeMatcher(matcher, sfm.options, num_images, why));
   };
   return stage;
 }

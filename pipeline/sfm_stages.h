@@ -62,17 +62,25 @@ struct SfmContext {
   const Colmap& colmap;
   Workspace workspace;
   CameraSetup camera;
-  bool sequential;  // Sequential matching (with loop closure) instead of exhaustive.
+  // MatcherFor: kAuto only past the exhaustive limit, where the capture's order decides.
+  MatcherChoice matcher;
   Progress& progress;
 };
 
-// Whether the matcher is sequential, and the sentence report.json gives for the choice.
-bool UseSequentialMatcher(const ReconstructOptions& options, int num_images);
-std::string DescribeMatcher(const ReconstructOptions& options, int num_images, bool sequential);
+// The matcher for `num_images` photos: the user's choice, exhaustive for an automatic choice
+// up to the limit, and kAuto past it (sequential or retrieval, decided in the matches stage).
+MatcherChoice MatcherFor(const ReconstructOptions& options, int num_images);
+// What report.json says of the matcher before matching (a dry run's plan); the matches stage
+// writes what it did into Workspace::MatchedMarker.
+std::string PlannedMatcher(const ReconstructOptions& options, int num_images);
 
 // `photos_key` is PhotosStage's key.
 Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key);
-Stage MatchesStage(const SfmContext& sfm, const std::string& features_key);
+// The vocabulary tree sequential and retrieval matching need, built from the photos' own
+// features by colmap vocab_tree_builder; not needed for exhaustive matching.
+Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key);
+Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
+                   const std::string& vocabulary_tree_key);
 // Notes the mapper's decisions (a principal-point refinement kept or rejected) in `notes`.
 Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
                   std::vector<std::string>& notes);

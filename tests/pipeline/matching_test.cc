@@ -1,0 +1,101 @@
+// The matcher past the exhaustive limit, through the real colmap on example_images/courtyard
+// (24 photos on a ring): sequential for photos in capture order, retrieval when their names
+// are shuffled, both from a vocabulary tree built from the photos.
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "colmap/database.h"
+#include "core/scene_folder.h"
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "eval/evaluate.h"
+#include "pipeline/reconstruct.h"
+#include "tests/temp_dir.h"
+
+namespace parallax {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kCourtyard = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "courtyard";
+
+// Past a limit of 10 images, with 4 neighbours a side and 8 retrieved images: far fewer pairs
+// than the 276 of exhaustive matching.
+ReconstructOptions MatchingPastTheLimit() {
+  ReconstructOptions options;
+  options.quality = Quality::kFast;
+  options.estimate_depth = false;
+  options.exhaustive_limit = 10;
+  options.sequential_overlap = 4;
+  options.retrieval_images = 8;
+  return options;
+}
+
+const StageRecord& StageNamed(const ReconstructSummary& summary, const std::string& name) {
+  for (const StageRecord& stage : summary.stages) {
+    if (stage.name == name) return stage;
+  }
+  throw std::runtime_error("no stage " + name);
+}
+
+TEST(Matching, OrderedPhotosMatchSequentiallyShuffledOnesByRetrieval) {
+  SilentProgress progress;
+  const ReconstructOptions options = MatchingPastTheLimit();
+
+  const TempDir ordered;
+  const ReconstructSummary sequential =
+      Reconstruct(kCourtyard / "images", ordered.Path(), options, progress);
+  EXPECT_NE(sequential.matcher.find("sequential"), std::string::npos) << sequential.matcher;
+  EXPECT_NE(sequential.matcher.find("100% of the photos consecutive in name order"),
+            std::string::npos) << sequential.matcher;
+  EXPECT_EQ(sequential.images_registered, 24);
+  EXPECT_FALSE(StageNamed(sequential, "vocabulary tree").skipped);
+  EXPECT_TRUE(fs::exists(Workspace(ordered.Path()).VocabularyTree()));
+  const PoseEvaluation poses = EvaluatePoses(ReadSparseModel(ordered.Path() / "sparse"),
+                                             ReadSparseModel(SceneFolder{kCourtyard}.Training().sparse));
+  EXPECT_EQ(poses.registered, 24);
+  EXPECT_LT(poses.rotation_error_mean_deg, 0.2);
+  const size_t sequential_pairs = ReadVerifiedPairs(Workspace(ordered.Path()).Database()).size();
+  EXPECT_LT(sequential_pairs, 276u / 2);
+
+  // Every 7th photo next: neighbours in name order are 105 degrees apart and share nothing.
+  const TempDir shuffled_photos;
+  for (int i = 0; i < 24; ++i) {
+    char from[16], to[32];
+    std::snprintf(from, sizeof(from), "%04d.png", (i * 7) % 24);
+    std::snprintf(to, sizeof(to), "shuffled_%02d.png", i);
+    fs::copy_file(kCourtyard / "images" / from, shuffled_photos.Path() / to);
+  }
+  const TempDir unordered;
+  const ReconstructSummary retrieval =
+      Reconstruct(shuffled_photos.Path(), unordered.Path(), options, progress);
+  EXPECT_NE(retrieval.matcher.find("retrieval"), std::string::npos) << retrieval.matcher;
+  EXPECT_NE(retrieval.matcher.find("not an ordered capture"), std::string::npos) << retrieval.matcher;
+  EXPECT_EQ(retrieval.images_registered, 24);
+  EXPECT_LT(retrieval.mean_reprojection_error_px, 1.0);
+  EXPECT_LT(ReadVerifiedPairs(Workspace(unordered.Path()).Database()).size(), 276u / 2);
+
+  // A second run skips every stage, the vocabulary tree too, and still says which matcher ran.
+  const ReconstructSummary again = Reconstruct(shuffled_photos.Path(), unordered.Path(), options, progress);
+  for (const StageRecord& stage : again.stages) EXPECT_TRUE(stage.skipped) << stage.name;
+  EXPECT_EQ(again.matcher, retrieval.matcher);
+}
+
+TEST(Matching, AnAutomaticChoiceUpToTheLimitIsExhaustiveAndNeedsNoTree) {
+  ReconstructOptions options;
+  options.dry_run = true;
+  SilentProgress progress;
+  const TempDir workspace;
+  const ReconstructSummary plan = Reconstruct(kCourtyard / "images", workspace.Path() / "ws", options, progress);
+  EXPECT_NE(plan.matcher.find("exhaustive (24 images, every pair), chosen automatically"),
+            std::string::npos) << plan.matcher;
+  const StageRecord& tree = StageNamed(plan, "vocabulary tree");
+  EXPECT_TRUE(tree.skipped);
+  EXPECT_NE(tree.reason.find("exhaustive matching"), std::string::npos) << tree.reason;
+}
+
+}  // namespace
+}  // namespace parallax
