@@ -48,6 +48,13 @@ std::map<std::string, DatabaseImage> ReadDatabaseImages(const std::filesystem::p
   return images;
 }
 
+int64_t CountDescriptors(const std::filesystem::path& database) {
+  int64_t count = 0;
+  ForEachRow(database, "SELECT SUM(rows) FROM descriptors",
+             [&](sqlite3_stmt* row) { count = sqlite3_column_int64(row, 0); });
+  return count;
+}
+
 std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database) {
   std::map<int64_t, std::string> names;
   ForEachRow(database, "SELECT image_id, name FROM images", [&](sqlite3_stmt* row) {

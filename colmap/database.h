@@ -33,6 +33,10 @@ struct VerifiedPair {
   PairGeometry geometry = PairGeometry::kUndefined;
 };
 
+// The number of feature descriptors stored for all images together. Throws BadInputError
+// naming the file if it cannot be read.
+int64_t CountDescriptors(const std::filesystem::path& database);
+
 // Every verified pair, in the database's order. Throws BadInputError naming the file if it
 // cannot be read.
 std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database);

@@ -58,7 +58,8 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
   nlohmann::json stages = nlohmann::json::array(), timings = nlohmann::json::object();
   for (const StageRecord& stage : summary.stages) {
     stages.push_back({{"name", stage.name}, {"skipped", stage.skipped}, {"reason", stage.reason},
-                      {"seconds", stage.seconds}, {"peak_rss_mb", stage.peak_rss_mb}});
+                      {"seconds", stage.seconds}, {"cpu_seconds", stage.cpu_seconds},
+                      {"peak_rss_mb", stage.peak_rss_mb}});
     timings[stage.name] = stage.seconds;
   }
   nlohmann::json skipped_files = nlohmann::json::array();

@@ -5,8 +5,8 @@
 #include <functional>
 #include <map>
 #include <set>
-#include <utility>
 #include <sstream>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
@@ -46,10 +46,19 @@ QualitySettings SettingsFor(Quality quality) {
 }
 
 // COLMAP publishes trees of 32K words for sets of up to about 1,000 images. parallax builds
-// one from the features of at most 30 of the photos: colmap's k-means costs about 100 s of CPU
-// for 24 photos' features already, and the cost would grow with the set.
+// one from the features of at most 30 of the photos: colmap's k-means costs about 140 s of CPU
+// for 25 photos' features already, and the cost would grow with the set.
 constexpr int kVocabularyTreeWords = 32768;
 constexpr int kVocabularyTreeTrainingImages = 30;
+
+// The words of the tree for `num_images` photos with `descriptors` features in all: colmap
+// needs at least one descriptor a word among the photos it samples, half of them to be safe
+// (the sample is random).
+int64_t VocabularyTreeWords(int num_images, int64_t descriptors) {
+  const int64_t sampled = descriptors * std::min(num_images, kVocabularyTreeTrainingImages) /
+                          std::max(num_images, 1);
+  return std::clamp<int64_t>(sampled / 2, 1, kVocabularyTreeWords);
+}
 
 std::string Percent(double share) {
   char text[16];
@@ -518,7 +527,8 @@ Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key
     const TemporaryOutput temporary(tree);
     sfm.colmap.Run("vocab_tree_builder",
                    {"--database_path", paths.Database().string(), "--vocab_tree_path",
-                    tree.string(), "--num_visual_words", std::to_string(kVocabularyTreeWords),
+                    tree.string(), "--num_visual_words",
+                    std::to_string(VocabularyTreeWords(num_images, CountDescriptors(paths.Database()))),
                     "--max_num_images",  // colmap refuses more than there are.
                     std::to_string(std::min(num_images, kVocabularyTreeTrainingImages))},
                    paths.Log("vocabulary_tree"), "vocabulary tree", num_images, sfm.progress);

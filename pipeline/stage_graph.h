@@ -36,6 +36,8 @@ struct StageRecord {
   // Peak resident memory of this process while the stage ran (colmap's own processes, which
   // some stages run, are not counted); 0 when it did not run.
   double peak_rss_mb = 0;
+  // CPU time of this process and the colmap processes it ran while the stage ran.
+  double cpu_seconds = 0;
 };
 
 class StageGraph {
