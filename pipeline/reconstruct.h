@@ -52,7 +52,7 @@ struct ReconstructOptions {
   std::string colmap = "colmap";
   // Above this many images the automatic matcher is sequential or retrieval (docs/scale.md:
   // where exhaustive matching starts to cost more than they do, measured).
-  int exhaustive_limit = 300;
+  int exhaustive_limit = 75;
   // colmap's SequentialMatching.overlap: each image is matched with the next overlap - 1
   // images in name order (and those a power of two ahead).
   int sequential_overlap = 20;
