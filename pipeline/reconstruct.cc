@@ -276,8 +276,9 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   const Stage matches = MatchesStage(sfm, features.key, vocabulary_tree.key);
   graph.Run(matches);
   // The marker says which matcher ran and why (older workspaces' markers hold only the key).
-  if (!options.dry_run && ReadFileBytes(paths.MatchedMarker()) != matches.key) {
-    summary.matcher = ReadFileBytes(paths.MatchedMarker());
+  if (!options.dry_run) {
+    const std::string matched = ReadFileBytes(paths.MatchedMarker());
+    if (matched != matches.key) summary.matcher = matched;
   }
   const Stage mapper = MapperStage(sfm, matches.key, summary.notes);
   graph.Run(mapper);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -66,17 +67,20 @@ std::string Percent(double share) {
   return text;
 }
 
-// report.json's sentence for the matcher that ran, `why` it was chosen when automatically.
+// Why the automatic matcher is not exhaustive for `num_images` photos.
+std::string PastTheLimit(const ReconstructOptions& options, int num_images) {
+  return std::to_string(num_images) + " images, more than " +
+         std::to_string(options.exhaustive_limit) + " for exhaustive matching";
+}
+
+// report.json's sentence for the matcher that ran, and why when it was chosen automatically;
+// past the exhaustive limit the choice rests on `consecutive_share` (Matching::ConsecutiveShare).
 std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& options,
-                            int num_images, std::string why) {
+                            int num_images, std::optional<double> consecutive_share) {
   std::string text;
   switch (matcher) {
     case MatcherChoice::kExhaustive:
       text = "exhaustive (" + std::to_string(num_images) + " images, every pair)";
-      if (options.matcher == MatcherChoice::kAuto) {
-        why = "chosen automatically: at most " + std::to_string(options.exhaustive_limit) +
-              " images";
-      }
       break;
     case MatcherChoice::kSequential:
       text = "sequential (each image with the next " +
@@ -90,7 +94,16 @@ std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& opt
       break;
     case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
   }
-  return why.empty() ? text : text + ", " + why;
+  if (options.matcher != MatcherChoice::kAuto) return text;
+  if (matcher == MatcherChoice::kExhaustive) {
+    return text + ", chosen automatically: at most " + std::to_string(options.exhaustive_limit) +
+           " images";
+  }
+  return text + ", chosen automatically: " + PastTheLimit(options, num_images) + ", and " +
+         Percent(consecutive_share.value()) +
+         " of the photos consecutive in name order match the next (" +
+         (matcher == MatcherChoice::kSequential ? "an ordered capture" : "not an ordered capture") +
+         ")";
 }
 
 // One run of the matches stage: colmap's matchers on the database being written.
@@ -385,10 +398,9 @@ std::string PlannedMatcher(const ReconstructOptions& options, int num_images) {
   const MatcherChoice matcher = MatcherFor(options, num_images);
   if (matcher == MatcherChoice::kAuto) {
     return "sequential or retrieval, as the photos' name order says once consecutive photos are "
-           "matched (" + std::to_string(num_images) + " images, more than " +
-           std::to_string(options.exhaustive_limit) + " for exhaustive matching)";
+           "matched (" + PastTheLimit(options, num_images) + ")";
   }
-  return DescribeMatcher(matcher, options, num_images, "");
+  return DescribeMatcher(matcher, options, num_images, std::nullopt);
 }
 
 fs::path ReadablePhotosDir(const fs::path& photos_dir, const PhotoSet& photos,
@@ -566,20 +578,16 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
                             {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
                              "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"}};
     MatcherChoice matcher = sfm.matcher;
-    std::string why;
+    std::optional<double> consecutive_share;
     if (matcher == MatcherChoice::kAuto) {
-      const double share = matching.ConsecutiveShare();
-      matcher = share >= sfm.options.ordered_share ? MatcherChoice::kSequential
-                                                   : MatcherChoice::kRetrieval;
-      why = "chosen automatically: " + std::to_string(num_images) + " images, more than " +
-            std::to_string(sfm.options.exhaustive_limit) + " for exhaustive matching, and " +
-            Percent(share) + " of the photos consecutive in name order match the next (" +
-            (matcher == MatcherChoice::kSequential ? "an ordered capture" : "not an ordered capture") +
-            ")";
+      consecutive_share = matching.ConsecutiveShare();
+      matcher = *consecutive_share >= sfm.options.ordered_share ? MatcherChoice::kSequential
+                                                                : MatcherChoice::kRetrieval;
     }
     matching.Run(matcher);
     fs::rename(database, paths.Database());
-    WriteFileAtomically(paths.MatchedMarker(), DescribeMatcher(matcher, sfm.options, num_images, why));
+    WriteFileAtomically(paths.MatchedMarker(),
+                        DescribeMatcher(matcher, sfm.options, num_images, consecutive_share));
   };
   return stage;
 }
