@@ -6,8 +6,10 @@
 #include <memory>
 #include <set>
 #include <cstring>
+#include <fstream>
 #include <numbers>
 #include <stdexcept>
+#include <unordered_map>
 
 #include <opencv2/imgproc.hpp>
 
@@ -187,13 +189,132 @@ class FusionViewCache {
 // for all of them).
 using UsedPixels = std::vector<std::vector<bool>>;
 
+// The fused points, indexed by the cell of space each lies in. A reference merges only with its
+// neighbours' pixels, so a surface that views far apart in the neighbour graph both see would be
+// fused once by each, and the cloud would grow with the number of photos. A new point is merged
+// instead into the nearest point an earlier reference fused that is the same sample of the same
+// surface: facing the same way, within a pixel of it along the surface and within the depth
+// tolerance across it. The cloud's density then follows the surface and the working resolution,
+// not the number of photos, and so do fusion's and the mesh's memory.
+class FusedCloud {
+ public:
+  explicit FusedCloud(const FusionOptions& options)
+      : min_normal_cos_(std::cos(options.max_normal_angle_deg * std::numbers::pi / 180)),
+        max_relative_depth_(options.max_relative_depth) {}
+
+  // The reference's own points are never merged with each other: they are one per pixel.
+  void BeginReference() { reference_start_ = points_.size(); }
+
+  // `depth`: the point's depth in the fusing view; `footprint`: that pixel's width there.
+  void Add(const FusedPoint& point, double depth, double footprint) {
+    const int level = static_cast<int>(std::ceil(std::log2(footprint))) + 1;
+    const std::optional<Cell> cell = CellOf(point.position, level);
+    if (!cell) {
+      points_.push_back(point);
+      next_in_cell_.push_back(kNone);
+      return;
+    }
+    const double max_across = std::min(max_relative_depth_ * depth, std::ldexp(1.0, level));
+    if (const std::optional<uint32_t> same = SameSample(point, *cell, footprint, max_across)) {
+      Merge(point, points_[*same]);
+      return;
+    }
+    const auto index = static_cast<uint32_t>(points_.size());
+    points_.push_back(point);
+    const auto [head, inserted] = cells_.try_emplace(*cell, index);
+    next_in_cell_.push_back(inserted ? kNone : head->second);
+    head->second = index;
+  }
+
+  std::vector<FusedPoint> Release() && { return std::move(points_); }
+
+ private:
+  static constexpr uint32_t kNone = UINT32_MAX;
+
+  // A cube 2^level wide, level chosen so that it is two to four pixels wide.
+  struct Cell {
+    int32_t x, y, z, level;
+    bool operator==(const Cell&) const = default;
+  };
+  struct CellHash {
+    size_t operator()(const Cell& cell) const {
+      uint64_t hash = 1469598103934665603ull;  // FNV-1a over the four coordinates.
+      for (const int32_t value : {cell.x, cell.y, cell.z, cell.level}) {
+        hash = (hash ^ static_cast<uint32_t>(value)) * 1099511628211ull;
+      }
+      return hash;
+    }
+  };
+
+  // None when the coordinates would not fit the cell's integers (a point absurdly far away).
+  static std::optional<Cell> CellOf(const Eigen::Vector3f& position, int level) {
+    const double size = std::ldexp(1.0, level);
+    Cell cell{0, 0, 0, level};
+    for (int axis = 0; axis < 3; ++axis) {
+      const double index = std::floor(static_cast<double>(position[axis]) / size);
+      if (!(std::abs(index) < 1e9)) return std::nullopt;
+      (&cell.x)[axis] = static_cast<int32_t>(index);
+    }
+    return cell;
+  }
+
+  // The nearest earlier point in the 27 cells around `cell` that `point` samples again.
+  std::optional<uint32_t> SameSample(const FusedPoint& point, const Cell& cell, double footprint,
+                                     double max_across) const {
+    std::optional<uint32_t> nearest;
+    double nearest_distance = 0;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto found = cells_.find({cell.x + dx, cell.y + dy, cell.z + dz, cell.level});
+          if (found == cells_.end()) continue;
+          for (uint32_t i = found->second; i != kNone; i = next_in_cell_[i]) {
+            if (i >= reference_start_) continue;
+            const FusedPoint& other = points_[i];
+            if (static_cast<double>(other.normal.dot(point.normal)) < min_normal_cos_) continue;
+            const Eigen::Vector3d offset = (point.position - other.position).cast<double>();
+            const double across = std::abs(offset.dot(other.normal.cast<double>()));
+            const double along = std::sqrt(std::max(0.0, offset.squaredNorm() - across * across));
+            if (across > max_across || along > footprint) continue;
+            if (!nearest || offset.norm() < nearest_distance) {
+              nearest = i;
+              nearest_distance = offset.norm();
+            }
+          }
+        }
+      }
+    }
+    return nearest;
+  }
+
+  // `into` becomes the mean of both, each weighted by the pixels it was fused from.
+  static void Merge(const FusedPoint& point, FusedPoint& into) {
+    const float a = into.views, b = point.views, sum = a + b;
+    into.position = (into.position * a + point.position * b) / sum;
+    into.normal = (into.normal * a + point.normal * b).normalized();
+    for (int c = 0; c < 3; ++c) {
+      const float linear = (SrgbToLinear(into.color[c] / 255.0f) * a + SrgbToLinear(point.color[c] / 255.0f) * b) / sum;
+      into.color[c] = static_cast<uint8_t>(std::lround(std::clamp(LinearToSrgb(linear), 0.0f, 1.0f) * 255));
+    }
+    into.views = static_cast<uint16_t>(std::min(sum, 65535.0f));
+  }
+
+  const double min_normal_cos_;
+  const double max_relative_depth_;
+  std::vector<FusedPoint> points_;
+  std::vector<uint32_t> next_in_cell_;  // Per point: the next point of its cell, or kNone.
+  std::unordered_map<Cell, uint32_t, CellHash> cells_;  // The last point added to each cell.
+  size_t reference_start_ = 0;
+};
+
 // The reference's unused pixels, each merged with the neighbours' pixels that see the same
 // surface, appended to `points`.
 void FuseReference(size_t reference_index, const std::map<size_t, FusionView*>& views, const FusionOptions& options,
-                   UsedPixels& used, std::vector<FusedPoint>& points) {
+                   UsedPixels& used, FusedCloud& cloud) {
   const double min_normal_cos = std::cos(options.max_normal_angle_deg * std::numbers::pi / 180);
   const FusionView& reference = *views.at(reference_index);
   std::vector<bool>& reference_used = used[reference_index];
+  cloud.BeginReference();
   for (int y = 0; y < reference.depth.Height(); ++y) {
     for (int x = 0; x < reference.depth.Width(); ++x) {
       const size_t pixel = static_cast<size_t>(y) * reference.depth.Width() + x;
@@ -238,7 +359,7 @@ void FuseReference(size_t reference_index, const std::map<size_t, FusionView*>& 
         fused.color[c] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0f, 1.0f) * 255));
       }
       fused.views = static_cast<uint16_t>(std::min(count, 65535));
-      points.push_back(fused);
+      cloud.Add(fused, static_cast<double>(depth), static_cast<double>(depth) / reference.camera.FocalX());
     }
   }
 }
@@ -269,35 +390,38 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
     const Camera camera = FusionCamera(model.CameraById(views[i]->camera_id), options);
     used[i].assign(static_cast<size_t>(camera.width) * static_cast<size_t>(camera.height), false);
   }
-  std::vector<FusedPoint> points;
+  FusedCloud cloud(options);
   const auto total = static_cast<int64_t>(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
     progress.Update("fusion", static_cast<int64_t>(i), total);
     std::vector<size_t> wanted = neighbours[i];
     wanted.push_back(i);
-    FuseReference(i, cache.Acquire(wanted), options, used, points);
+    FuseReference(i, cache.Acquire(wanted), options, used, cloud);
   }
   progress.Update("fusion", total, total);
-  return points;
+  return std::move(cloud).Release();
 }
 
 void WritePly(const fs::path& path, const std::vector<FusedPoint>& points) {
-  std::string bytes = "ply\nformat binary_little_endian 1.0\nelement vertex " +
-                      std::to_string(points.size()) +
-                      "\nproperty float x\nproperty float y\nproperty float z\n"
-                      "property float nx\nproperty float ny\nproperty float nz\n"
-                      "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
-  const size_t header = bytes.size();
-  constexpr size_t kVertexBytes = 6 * sizeof(float) + 3;
-  bytes.resize(header + points.size() * kVertexBytes);
-  char* out = bytes.data() + header;
-  for (const FusedPoint& point : points) {
-    std::memcpy(out, point.position.data(), 3 * sizeof(float));
-    std::memcpy(out + 3 * sizeof(float), point.normal.data(), 3 * sizeof(float));
-    std::memcpy(out + 6 * sizeof(float), point.color.data(), 3);
-    out += kVertexBytes;
-  }
-  WriteFileAtomically(path, bytes);
+  const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " +
+                             std::to_string(points.size()) +
+                             "\nproperty float x\nproperty float y\nproperty float z\n"
+                             "property float nx\nproperty float ny\nproperty float nz\n"
+                             "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+  // Streamed: a copy of the whole cloud in memory would double fusion's peak.
+  WriteAtomically(path, [&](const fs::path& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    out << header;
+    std::array<char, 6 * sizeof(float) + 3> vertex{};
+    for (const FusedPoint& point : points) {
+      std::memcpy(vertex.data(), point.position.data(), 3 * sizeof(float));
+      std::memcpy(vertex.data() + 3 * sizeof(float), point.normal.data(), 3 * sizeof(float));
+      std::memcpy(vertex.data() + 6 * sizeof(float), point.color.data(), 3);
+      out.write(vertex.data(), vertex.size());
+    }
+    out.close();
+    if (!out) throw BadInputError("cannot write " + path.string());
+  });
 }
 
 }  // namespace parallax

@@ -20,7 +20,7 @@ namespace {
 
 // Bump when a stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-6";
-constexpr const char* kFusionVersion = "fusion-4";
+constexpr const char* kFusionVersion = "fusion-5";
 constexpr const char* kMeshVersion = "mesh-3";
 constexpr const char* kColorGainsVersion = "color-gains-1";
 
