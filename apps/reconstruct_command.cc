@@ -24,7 +24,9 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
     } else if (dry_run) {
       std::printf("  %-12s will run: %s\n", stage.name.c_str(), stage.reason.c_str());
     } else {
-      std::printf("  %-12s %7.1f s %7.0f MB\n", stage.name.c_str(), stage.seconds, stage.peak_rss_mb);
+      std::printf("  %-12s %7.1f s %7.0f MB", stage.name.c_str(), stage.seconds, stage.peak_rss_mb);
+      if (stage.tool_peak_rss_mb > 0) std::printf(" (colmap %.0f MB)", stage.tool_peak_rss_mb);
+      std::printf("\n");
     }
   }
   if (!dry_run) {

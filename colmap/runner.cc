@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "colmap/subprocess.h"
 
 namespace parallax {
@@ -68,6 +69,7 @@ void Colmap::Run(const std::string& command, const std::vector<std::string>& arg
         if (step.done >= 0) progress.Update(stage, step.done, step.total);
       });
   log.flush();
+  NoteChildPeakMemory(result.peak_memory_kb);
   if (result.exit_code != 0) {
     // A full disk is the user's to fix, not colmap's failure; its log may not even say so.
     const std::string disk_full = DiskFullReason(log_path.parent_path());

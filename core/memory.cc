@@ -1,13 +1,32 @@
 #include "core/memory.h"
 
+#include <malloc.h>
 #include <sys/resource.h>
 
+#include <atomic>
 #include <fstream>
 #include <string>
 
 namespace parallax {
 
+namespace {
+
+std::atomic<long> children_peak_kb{0};
+
+}  // namespace
+
+void ReturnFreedMemory() { malloc_trim(0); }
+
+void NoteChildPeakMemory(long peak_kb) {
+  long seen = children_peak_kb.load();
+  while (peak_kb > seen && !children_peak_kb.compare_exchange_weak(seen, peak_kb)) {
+  }
+}
+
+double PeakChildResidentMemoryMb() { return static_cast<double>(children_peak_kb.load()) / 1024.0; }
+
 bool ResetPeakResidentMemory() {
+  children_peak_kb = 0;
   std::ofstream clear_refs("/proc/self/clear_refs");
   clear_refs << "5";
   return static_cast<bool>(clear_refs.flush());

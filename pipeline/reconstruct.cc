@@ -59,7 +59,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
   for (const StageRecord& stage : summary.stages) {
     stages.push_back({{"name", stage.name}, {"skipped", stage.skipped}, {"reason", stage.reason},
                       {"seconds", stage.seconds}, {"cpu_seconds", stage.cpu_seconds},
-                      {"peak_rss_mb", stage.peak_rss_mb}});
+                      {"peak_rss_mb", stage.peak_rss_mb}, {"tool_peak_rss_mb", stage.tool_peak_rss_mb}});
     timings[stage.name] = stage.seconds;
   }
   nlohmann::json skipped_files = nlohmann::json::array();

@@ -19,7 +19,7 @@ StageGraph::StageGraph(const Workspace& workspace, bool dry_run)
     : cache_(workspace.Stages()), dry_run_(dry_run) {}
 
 void StageGraph::Run(const Stage& stage) {
-  StageRecord record{stage.name, false, "", 0, 0, 0};
+  StageRecord record{stage.name, false, "", 0, 0, 0, 0};
   const bool outputs_exist = AllExist(stage.outputs);
   if (cache_.IsDone(stage.name, stage.key) && outputs_exist) {
     record.skipped = true;
@@ -30,12 +30,14 @@ void StageGraph::Run(const Stage& stage) {
                     : outputs_exist           ? "inputs or options changed"
                                               : "not run yet";
   } else {
+    ReturnFreedMemory();
     ResetPeakResidentMemory();
     const double cpu_start = CpuSeconds();
     const auto start = std::chrono::steady_clock::now();
     stage.run();
     record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     record.peak_rss_mb = PeakResidentMemoryMb();
+    record.tool_peak_rss_mb = PeakChildResidentMemoryMb();
     record.cpu_seconds = CpuSeconds() - cpu_start;
     cache_.MarkDone(stage.name, stage.key);
     record.skipped = !stage.not_needed.empty();

@@ -33,9 +33,10 @@ struct StageRecord {
   bool skipped = false;
   std::string reason;
   double seconds = 0;
-  // Peak resident memory of this process while the stage ran (colmap's own processes, which
-  // some stages run, are not counted); 0 when it did not run.
+  // Peak resident memory of this process while the stage ran, and the largest of the colmap
+  // processes it ran (each on its own, beside this one); 0 when it did not run (or ran none).
   double peak_rss_mb = 0;
+  double tool_peak_rss_mb = 0;
   // CPU time of this process and the colmap processes it ran while the stage ran.
   double cpu_seconds = 0;
 };
