@@ -115,6 +115,36 @@ std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
   return views;
 }
 
+// The Poisson surface of <ws>/fused.ply, trimmed to where the cloud has data; the count of
+// Poisson's own triangles in `poisson_triangles`. The cloud is only in memory in here.
+TriangleMesh TrimmedPoissonSurface(const Workspace& ws, const Colmap& colmap, const MeshOptions& options,
+                                   Progress& progress, size_t& poisson_triangles) {
+  const fs::path fused = ws.Fused();
+  const std::vector<Eigen::Vector3f> points = ReadPly(fused).vertices;
+  if (points.size() < 100) {
+    throw BadInputError(fused.string() + ": only " + std::to_string(points.size()) +
+                        " fused points, too few to mesh");
+  }
+  const fs::path poisson = ws.PoissonMesh();
+  const fs::path temporary = ws.PoissonMeshScratch();
+  colmap.Run("poisson_mesher",
+             {"--input_path", fused.string(), "--output_path", temporary.string(),
+              "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
+              std::to_string(options.poisson_trim)},
+             ws.Log("mesh"), "mesh", 0, progress);
+  fs::rename(temporary, poisson);
+
+  progress.Update("trim", 0, 1);
+  // colmap's solver now and then writes a NaN vertex: its triangles go, the rest is kept.
+  const TriangleMesh raw = ReadPly(poisson, NonFiniteVertices::kDropTheirTriangles);
+  poisson_triangles = raw.triangles.size();
+  const float cell = OctreeCell(points, options.poisson_depth);
+  const float radius = static_cast<float>(options.max_cells_from_data) * cell;
+  TriangleMesh trimmed = Trim(raw, PointGrid(points, radius), radius);
+  progress.Update("trim", 1, 1);
+  return trimmed;
+}
+
 }  // namespace
 
 void MeshOptions::Check() const {
@@ -136,37 +166,24 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
                           const MeshOptions& options, Progress& progress) {
   options.Check();
   const Workspace ws(workspace);
-  const fs::path fused = ws.Fused();
-  const std::vector<Eigen::Vector3f> points = ReadPly(fused).vertices;
-  if (points.size() < 100) {
-    throw BadInputError(fused.string() + ": only " + std::to_string(points.size()) +
-                        " fused points, too few to mesh");
-  }
-  const fs::path poisson = ws.PoissonMesh();
-  const fs::path temporary = ws.PoissonMeshScratch();
-  colmap.Run("poisson_mesher",
-             {"--input_path", fused.string(), "--output_path", temporary.string(),
-              "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
-              std::to_string(options.poisson_trim)},
-             ws.Log("mesh"), "mesh", 0, progress);
-  fs::rename(temporary, poisson);
-
-  progress.Update("trim", 0, 1);
-  // colmap's solver now and then writes a NaN vertex: its triangles go, the rest is kept.
-  const TriangleMesh raw = ReadPly(poisson, NonFiniteVertices::kDropTheirTriangles);
-  const float cell = OctreeCell(points, options.poisson_depth);
-  const float radius = static_cast<float>(options.max_cells_from_data) * cell;
-  const TriangleMesh trimmed = Trim(raw, PointGrid(points, radius), radius);
-  progress.Update("trim", 1, 1);
+  MeshSummary summary;
+  const TriangleMesh trimmed = TrimmedPoissonSurface(ws, colmap, options, progress, summary.poisson_triangles);
+  summary.triangles = trimmed.triangles.size();
+  summary.vertices = trimmed.vertices.size();
 
   progress.Update("texture", 0, 1);
   const std::vector<TextureView> views = LoadTextureViews(workspace);
-  TextureSummary texture;
-  const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
-  WriteTexturedMesh(ws.MeshDir(), textured);
+  {  // The full atlas is freed before the display copy's is made.
+    TextureSummary texture;
+    const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
+    WriteTexturedMesh(ws.MeshDir(), textured);
+    summary.texels_per_edge = texture.texels_per_edge;
+    summary.untextured_triangles = texture.untextured_triangles;
+    summary.atlas_width = textured.atlas.Width();
+    summary.atlas_height = textured.atlas.Height();
+  }
   progress.Update("texture", 1, 1);
 
-  MeshSummary summary;
   const fs::path display = ws.DisplayMeshDir();
   if (trimmed.triangles.size() > options.display_max_triangles) {
     progress.Update("display mesh", 0, 1);
@@ -179,13 +196,6 @@ MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
   } else {
     fs::remove_all(display);  // A stale one from a larger mesh would be shown instead.
   }
-  summary.poisson_triangles = raw.triangles.size();
-  summary.triangles = trimmed.triangles.size();
-  summary.vertices = trimmed.vertices.size();
-  summary.texels_per_edge = texture.texels_per_edge;
-  summary.untextured_triangles = texture.untextured_triangles;
-  summary.atlas_width = textured.atlas.Width();
-  summary.atlas_height = textured.atlas.Height();
   return summary;
 }
 
