@@ -293,11 +293,15 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     return summary;
   }
   summary.stages = graph.Records();  // The report a --strict failure writes lists them.
-  const SparseModel raw_model = CheckRawModel(sfm, summary);
-  const Stage undistort = UndistortStage(sfm, mapper.key, &raw_model);
-  graph.Run(undistort);
+  std::string undistort_key;
+  {  // The raw model (every photo's keypoints) is not kept through the dense stages.
+    const SparseModel raw_model = CheckRawModel(sfm, summary);
+    const Stage undistort = UndistortStage(sfm, mapper.key, &raw_model);
+    graph.Run(undistort);
+    undistort_key = undistort.key;
+  }
   FillModelStatistics(ReadSparseModel(sfm.workspace.Sparse()), photos, summary);
-  if (options.estimate_depth) RunDenseStages(sfm, undistort.key, graph, summary);
+  if (options.estimate_depth) RunDenseStages(sfm, undistort_key, graph, summary);
   summary.stages = graph.Records();
   WriteReport(sfm.workspace.Report(), summary);
   return summary;
