@@ -1,15 +1,13 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <sstream>
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
+#include "apps/slurm_cli.h"
 #include "apps/terminal_progress.h"
-#include "core/atomic_file.h"
 #include "core/error.h"
 #include "pipeline/reconstruct.h"
-#include "pipeline/slurm.h"
 
 namespace parallax {
 namespace {
@@ -46,47 +44,6 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
   if (!dry_run) std::printf("workspace: %s (report.json)\n", workspace.string().c_str());
 }
 
-// The options as given, for the cluster's jobs to repeat: every option used except the
-// executor's own; the folders made absolute.
-std::vector<std::string> JobArguments(const CLI::App& command, const std::filesystem::path& photos,
-                                      const std::filesystem::path& workspace) {
-  std::vector<std::string> arguments = {"reconstruct", std::filesystem::absolute(photos).string(),
-                                        std::filesystem::absolute(workspace).string()};
-  for (const CLI::Option* option : command.get_options()) {
-    const std::string name = option->get_name();
-    if (option->count() == 0 || option->get_positional() || name == "--help" || name == "--executor" ||
-        name.starts_with("--slurm") || name.starts_with("--sbatch")) {
-      continue;
-    }
-    arguments.push_back(name);
-    if (option->get_type_size() != 0) {
-      for (const std::string& value : option->results()) arguments.push_back(value);
-    }
-  }
-  return arguments;
-}
-
-// Whitespace-separated sbatch options, from --sbatch and from --sbatch-file (where '#' starts
-// a comment).
-std::vector<std::string> SbatchOptions(const std::string& inline_options, const std::filesystem::path& file) {
-  std::string text = inline_options;
-  if (!file.empty()) {
-    std::istringstream lines(ReadFileBytes(file));
-    for (std::string line; std::getline(lines, line);) text += " " + line.substr(0, line.find('#'));
-  }
-  std::istringstream words(text);
-  std::vector<std::string> options;
-  for (std::string word; words >> word;) options.push_back(word);
-  return options;
-}
-
-void PrintSubmission(const SlurmSubmission& submission, bool waited) {
-  std::string ids;
-  for (const std::string& id : submission.job_ids) ids += (ids.empty() ? "" : ",") + id;
-  std::printf("slurm: submitted jobs %s (scripts and logs in %s)\n", ids.c_str(), submission.folder.c_str());
-  if (!waited) std::printf("slurm: follow them with `squeue -j %s`\n", ids.c_str());
-}
-
 }  // namespace
 
 void RegisterReconstructCommand(CLI::App& app) {
@@ -97,10 +54,7 @@ void RegisterReconstructCommand(CLI::App& app) {
     std::string camera_model = "SIMPLE_RADIAL";
     bool no_depth = false;
     bool no_mesh = false;
-    std::string executor = "local";
-    SlurmOptions slurm;
-    std::string sbatch;
-    std::filesystem::path sbatch_file;
+    SlurmCli slurm;
     ReconstructOptions options;
   };
   auto arguments = std::make_shared<Arguments>();
@@ -168,34 +122,20 @@ void RegisterReconstructCommand(CLI::App& app) {
                     "print the plan (stages to run or skip, and why) and stop");
   command->add_option("--colmap", arguments->options.colmap,
                       "colmap executable (default: colmap on PATH)");
-  command->add_option("--executor", arguments->executor,
-                      "local (default), or slurm: submit SfM, the depth passes as job arrays and "
-                      "the rest as Slurm jobs on storage every node shares, and return")
-      ->check(CLI::IsMember({"local", "slurm"}));
-  command->add_option("--slurm-block-size", arguments->slurm.block_size,
-                      "views per depth task with --executor slurm (default 8)")
-      ->check(CLI::Range(1, 100000));
-  command->add_option("--sbatch", arguments->sbatch,
-                      "options for every sbatch, e.g. \"--partition=cpu --time=2:00:00 --mem=8G "
-                      "--cpus-per-task=8\"");
-  command->add_option("--sbatch-file", arguments->sbatch_file,
-                      "file of sbatch options (one or more per line, # comments)")
-      ->check(CLI::ExistingFile);
-  command->add_flag("--slurm-wait", arguments->slurm.wait,
-                    "with --executor slurm: return when the last job has ended, with its status");
+  AddSlurmOptions(*command, arguments->slurm, "SfM, the depth passes as job arrays and the rest",
+                  "views per depth task");
   command->callback([arguments, command] {
     ReconstructOptions options = arguments->options;
     options.camera_model = CameraModelFromName(arguments->camera_model);
     options.estimate_depth = !arguments->no_depth;
     options.build_mesh = !arguments->no_depth && !arguments->no_mesh;
     if (!arguments->intrinsics.empty()) options.intrinsics = ParseNumberList(arguments->intrinsics, "--intrinsics");
-    if (arguments->executor == "slurm") {
+    if (arguments->slurm.OnSlurm()) {
       options.Check();
-      SlurmOptions slurm = arguments->slurm;
-      slurm.sbatch_options = SbatchOptions(arguments->sbatch, arguments->sbatch_file);
-      const SlurmSubmission submission = SubmitReconstructToSlurm(
-          arguments->photos, arguments->workspace, options, std::filesystem::canonical("/proc/self/exe").string(),
-          JobArguments(*command, arguments->photos, arguments->workspace), slurm);
+      const SlurmOptions slurm = arguments->slurm.Resolve();
+      const SlurmSubmission submission =
+          SubmitReconstructToSlurm(arguments->photos, arguments->workspace, options, ThisExecutable(),
+                                   JobArguments(*command, {arguments->photos, arguments->workspace}), slurm);
       PrintSubmission(submission, slurm.wait);
       return;
     }

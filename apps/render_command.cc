@@ -1,11 +1,13 @@
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "apps/commands.h"
 #include "apps/novel_view_options.h"
+#include "apps/slurm_cli.h"
 #include "apps/terminal_progress.h"
 #include "pipeline/render_request.h"
 
@@ -18,6 +20,8 @@ void RegisterRenderCommand(CLI::App& app) {
     std::string path;
     std::filesystem::path out;
     NovelViewSettings settings;
+    SlurmCli slurm;
+    RenderPart part;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -37,10 +41,31 @@ void RegisterRenderCommand(CLI::App& app) {
   path->excludes(cameras);
   command->add_option("--out", arguments->out, "output folder (created if missing)")->required();
   AddNovelViewOptions(*command, arguments->settings);
-  command->callback([arguments] {
+  AddSlurmOptions(*command, arguments->slurm, "the frames as a job array (then one job collects render.csv)",
+                  "frames per task");
+  // The jobs' steps (pipeline/render_request.h RenderStep); not for people.
+  const std::map<std::string, RenderStep> steps = {
+      {"prepare", RenderStep::kPrepare}, {"frames", RenderStep::kFrames}, {"collect", RenderStep::kCollect}};
+  command->add_option("--job-step", arguments->part.step)
+      ->transform(CLI::CheckedTransformer(steps))
+      ->group("");
+  command->add_option("--block", arguments->part.block)->check(CLI::NonNegativeNumber)->group("");
+  command->add_option("--block-size", arguments->part.block_size)->check(CLI::PositiveNumber)->group("");
+  command->callback([arguments, command] {
     arguments->settings.Resolve();
     if (arguments->cameras.empty() && arguments->path.empty()) {
       throw CLI::ValidationError("render", "give the cameras: --cameras <model_dir> or --path <spec>");
+    }
+    const RenderTargets targets{arguments->cameras, arguments->path.empty()
+                                                        ? std::nullopt
+                                                        : std::optional(ParseCameraPath(arguments->path))};
+    if (arguments->slurm.OnSlurm()) {
+      const SlurmOptions slurm = arguments->slurm.Resolve();
+      const SlurmSubmission submission = SubmitRenderToSlurm(
+          arguments->out, CountRenderTargets(arguments->input, targets), ThisExecutable(),
+          JobArguments(*command, {arguments->input}, {"--out", "--cameras"}), slurm);
+      PrintSubmission(submission, slurm.wait);
+      return;
     }
     const auto print_view = [](size_t i, size_t count, const NamedCamera& target, const NovelView& view) {
       std::fprintf(stderr, "render %zu/%zu %s: %zu sources, holes %.2f%% -> %.2f%% filled, %.0f ms\n",
@@ -51,12 +76,14 @@ void RegisterRenderCommand(CLI::App& app) {
     RenderSummary summary;
     {
       TerminalProgress progress;
-      const RenderTargets targets{arguments->cameras, arguments->path.empty()
-                                                          ? std::nullopt
-                                                          : std::optional(ParseCameraPath(arguments->path))};
-      summary = RenderCameras(arguments->input, targets,
-                              arguments->settings, arguments->out,
-                              progress, print_view);
+      summary = RenderCameras(arguments->input, targets, arguments->settings, arguments->out, progress, print_view,
+                              arguments->part);
+    }
+    if (arguments->part.step != RenderStep::kAll) {
+      for (const RequestStage& stage : summary.stages) {
+        std::printf("render %s: %s\n", stage.name.c_str(), stage.reason.c_str());
+      }
+      return;
     }
     if (!summary.depth_note.empty()) std::printf("depth: %s\n", summary.depth_note.c_str());
     for (const std::string& name : summary.dropped) {

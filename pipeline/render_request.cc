@@ -1,11 +1,13 @@
 #include "pipeline/render_request.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <set>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/workspace.h"
 #include "core/workspace_lock.h"
 #include "mvs/mvs.h"
@@ -116,9 +118,67 @@ void to_json(nlohmann::json& json, const RequestStage& stage) {
   json = {{"name", stage.name}, {"skipped", stage.skipped}, {"reason", stage.reason}};
 }
 
+namespace {
+
+std::vector<NamedCamera> TargetCameras(const RenderTargets& cameras, const SourceLibrary& library) {
+  return cameras.path ? CamerasAlongPath(*cameras.path, library.Cameras(), library.Names())
+                      : CamerasFromModel(cameras.model);
+}
+
+constexpr const char* kCsvHeader =
+    "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
+    "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
+
+fs::path BlocksFolder(const fs::path& out) { return out / "blocks"; }
+fs::path BlockCsv(const fs::path& out, int block) { return BlocksFolder(out) / (std::to_string(block) + ".csv"); }
+fs::path BlockReport(const fs::path& out, const std::string& block) { return BlocksFolder(out) / (block + ".json"); }
+
+void WriteStages(const fs::path& file, const std::vector<RequestStage>& stages) {
+  WriteFileAtomically(file, nlohmann::json({{"render", {{"stages", stages}}}}).dump(2) + "\n");
+}
+
+nlohmann::json ReadBlockReport(const fs::path& file) {
+  if (!fs::exists(file)) throw BadInputError(file.string() + " is missing: that block has not run (or failed)");
+  try {
+    return nlohmann::json::parse(ReadFileBytes(file)).at("render").at("stages");
+  } catch (const nlohmann::json::exception& error) {
+    throw BadInputError(file.string() + " is not a render block's report: " + error.what());
+  }
+}
+
+// render.csv and report.json from the blocks the frames were rendered in.
+RenderSummary CollectBlocks(const fs::path& out, size_t frames, int block_size) {
+  const int blocks = static_cast<int>((frames + block_size - 1) / block_size);
+  std::string csv = kCsvHeader;
+  nlohmann::json block_stages = nlohmann::json::array();
+  for (int block = 0; block < blocks; ++block) {
+    block_stages.push_back(ReadBlockReport(BlockReport(out, std::to_string(block))));
+    csv += ReadFileBytes(BlockCsv(out, block));
+  }
+  RenderSummary summary;
+  summary.views = frames;
+  summary.stages = {Ran("frames", "collected " + std::to_string(frames) + " cameras from " + std::to_string(blocks) +
+                                      " blocks of " + std::to_string(block_size) + " (each block's stages under blocks)")};
+  nlohmann::json stages = ReadBlockReport(BlockReport(out, "prepare"));
+  stages.push_back(summary.stages.front());
+  WriteFileAtomically(out / "render.csv", csv);
+  WriteFileAtomically(out / "report.json",
+                      nlohmann::json({{"render", {{"stages", stages}, {"blocks", block_stages}}}}).dump(2) + "\n");
+  return summary;
+}
+
+}  // namespace
+
+size_t CountRenderTargets(const fs::path& input, const RenderTargets& targets) {
+  return TargetCameras(targets, SourceLibrary(SourcePathsFor(input))).size();
+}
+
 RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
                             const NovelViewSettings& settings, const fs::path& out,
-                            Progress& progress, const RenderedView& on_view) {
+                            Progress& progress, const RenderedView& on_view, const RenderPart& part) {
+  if (part.step == RenderStep::kCollect) {
+    return CollectBlocks(out, CountRenderTargets(input, cameras), part.block_size);
+  }
   RenderSummary summary;
   const SceneFolder scene{input};
   const bool scene_folder = fs::is_directory(scene.GroundTruth());
@@ -129,9 +189,16 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains, lock ? &*lock : nullptr));
   if (!settings.color_gains) source_paths.color_gains.clear();
   SourceLibrary library(source_paths);
-  const std::vector<NamedCamera> targets =
-      cameras.path ? CamerasAlongPath(*cameras.path, library.Cameras(), library.Names())
-                   : CamerasFromModel(cameras.model);
+  std::vector<NamedCamera> targets = TargetCameras(cameras, library);
+  if (part.step == RenderStep::kFrames) {
+    const size_t first = std::min(targets.size(), static_cast<size_t>(part.block) * part.block_size);
+    const size_t last = std::min(targets.size(), first + part.block_size);
+    targets = std::vector<NamedCamera>(targets.begin() + first, targets.begin() + last);
+    if (fs::exists(BlockCsv(out, part.block))) {
+      summary.stages = {Skipped("frames", "block " + std::to_string(part.block) + " already rendered")};
+      return summary;
+    }
+  }
   summary.source_views = library.Cameras().size();
   if (scene_folder) {
     summary.stages.push_back(Skipped("depth", "a scene folder: its ground-truth depth maps are used"));
@@ -143,12 +210,15 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   summary.stages.push_back(Skipped("mesh", "only novel views are requested: building the Poisson mesh and its "
                                            "texture atlas for them would cost more than the holes it fills "
                                            "(one that reconstruct made is used, see depth_holes)"));
+  if (part.step == RenderStep::kPrepare) {
+    fs::create_directories(BlocksFolder(out));
+    WriteStages(BlockReport(out, "prepare"), summary.stages);
+    return summary;
+  }
   summary.dropped = library.DropViewsWithoutDepth();
   const WorkspaceDepthPreparation depth_holes =
       scene_folder ? WorkspaceDepthPreparation{} : PrepareWorkspaceDepth(input, settings, &library);
-  std::string csv =
-      "name,sources,hole_ratio,hole_ratio_filled,crack_ratio,disocclusion_ratio,"
-      "out_of_view_ratio,background_ratio,holes,largest_hole_px,fill,ms\n";
+  std::string csv;
   double hole_sum = 0, filled_sum = 0, ms_sum = 0;
   std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.
   Renderer renderer(settings.render);
@@ -163,16 +233,21 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
     if (!view.result.fill.skipped.empty()) ++fill_skipped[view.result.fill.skipped];
     if (on_view) on_view(i, targets.size(), targets[i], view);
   }
-  WriteFileAtomically(out / "render.csv", csv);
   summary.sources_loaded = library.LoadedCount();
   summary.stages.push_back(Ran("sources", "loaded " + std::to_string(library.LoadedCount()) + " of " +
                                               std::to_string(summary.source_views) +
                                               " source views: the others can not contribute to these cameras"));
   summary.stages.push_back(DepthHolesStage(scene_folder, library, depth_holes));
   summary.stages.push_back(FillStage(fill_skipped, targets.size()));
-  WriteFileAtomically(out / "report.json",
-                      nlohmann::json({{"render", {{"stages", summary.stages}}}}).dump(2) + "\n");
-  const double n = static_cast<double>(targets.size());
+  if (part.step == RenderStep::kFrames) {
+    // The report first: a block counts as done once its rows are there.
+    WriteStages(BlockReport(out, std::to_string(part.block)), summary.stages);
+    WriteFileAtomically(BlockCsv(out, part.block), csv);
+  } else {
+    WriteFileAtomically(out / "render.csv", kCsvHeader + csv);
+    WriteStages(out / "report.json", summary.stages);
+  }
+  const double n = static_cast<double>(std::max<size_t>(1, targets.size()));
   summary.views = targets.size();
   summary.hole_ratio_mean = hole_sum / n;
   summary.hole_ratio_filled_mean = filled_sum / n;

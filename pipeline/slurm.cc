@@ -128,6 +128,19 @@ DepthRequest ReadDepthRequest(const Workspace& workspace) {
   }
 }
 
+// Submits `jobs` from `folder`, each after the one before succeeded; with slurm.wait, returns
+// when the last has ended and throws unless every one completed.
+SlurmSubmission SubmitChain(const SlurmOptions& slurm, const fs::path& folder, const std::vector<Job>& jobs) {
+  SlurmSubmission submission{{}, folder};
+  std::string after;
+  for (const Job& job : jobs) {
+    after = Submit(slurm, folder, job, after, slurm.wait && &job == &jobs.back());
+    submission.job_ids.push_back(after);
+  }
+  if (slurm.wait) CheckCompleted(submission.job_ids, folder);
+  return submission;
+}
+
 }  // namespace
 
 SlurmSubmission SubmitReconstructToSlurm(const fs::path& photos_dir, const fs::path& workspace,
@@ -142,7 +155,6 @@ SlurmSubmission SubmitReconstructToSlurm(const fs::path& photos_dir, const fs::p
   const fs::path folder = SlurmFolder(ws);
   fs::create_directories(folder / "logs");
   const std::string reconstruct = CommandLine({parallax}) + " " + CommandLine(reconstruct_arguments);
-  SlurmSubmission submission{{}, folder};
   std::vector<Job> jobs;
   if (!options.estimate_depth) {
     WriteJobScript(folder / "sfm.sh", {reconstruct});
@@ -158,13 +170,20 @@ SlurmSubmission SubmitReconstructToSlurm(const fs::path& photos_dir, const fs::p
     WriteJobScript(folder / "final.sh", {depth_block + " collect", reconstruct});
     jobs = {{"sfm"}, {"photometric", tasks}, {"geometric", tasks}, {"final"}};
   }
-  std::string after;
-  for (const Job& job : jobs) {
-    after = Submit(slurm, folder, job, after, slurm.wait && &job == &jobs.back());
-    submission.job_ids.push_back(after);
-  }
-  if (slurm.wait) CheckCompleted(submission.job_ids, folder);
-  return submission;
+  return SubmitChain(slurm, folder, jobs);
+}
+
+SlurmSubmission SubmitRenderToSlurm(const fs::path& out, size_t frames, const std::string& parallax,
+                                    const std::vector<std::string>& render_arguments, const SlurmOptions& slurm) {
+  const fs::path folder = out / "slurm";
+  fs::create_directories(folder / "logs");
+  const std::string render = CommandLine({parallax}) + " " + CommandLine(render_arguments) + " --block-size " +
+                             std::to_string(slurm.block_size) + " --job-step ";
+  const int tasks = std::max(1, static_cast<int>((frames + slurm.block_size - 1) / slurm.block_size));
+  WriteJobScript(folder / "prepare.sh", {render + "prepare"});
+  WriteJobScript(folder / "frames.sh", {render + "frames --block \"$SLURM_ARRAY_TASK_ID\""});
+  WriteJobScript(folder / "collect.sh", {render + "collect"});
+  return SubmitChain(slurm, folder, {{"prepare"}, {"frames", tasks}, {"collect"}});
 }
 
 std::string RunDepthBlockStep(const fs::path& workspace, DepthBlockStep step, const MvsBlock& block,

@@ -18,7 +18,7 @@
 namespace parallax {
 
 struct SlurmOptions {
-  int block_size = 8;                       // Views per array task.
+  int block_size = 8;                       // Views (or frames) per array task.
   std::vector<std::string> sbatch_options;  // Given to every sbatch: partition, time, memory, CPUs.
   bool wait = false;                        // Return when the last job has ended (sbatch --wait).
   std::string sbatch = "sbatch";
@@ -39,6 +39,14 @@ SlurmSubmission SubmitReconstructToSlurm(const std::filesystem::path& photos_dir
                                          const std::string& parallax,
                                          const std::vector<std::string>& reconstruct_arguments,
                                          const SlurmOptions& slurm);
+
+// `render --executor slurm`: one job writes what every frame reads (color gains, missing
+// depth), a job array renders the `frames` cameras a block each (`slurm.block_size` frames per
+// task), and one job collects the blocks into render.csv and report.json
+// (pipeline/render_request.h RenderStep); the scripts and logs go to <out>/slurm.
+// `render_arguments` is the render command line each job repeats, less the executor's options.
+SlurmSubmission SubmitRenderToSlurm(const std::filesystem::path& out, size_t frames, const std::string& parallax,
+                                    const std::vector<std::string>& render_arguments, const SlurmOptions& slurm);
 
 // The steps of `parallax depth-block`, which the jobs run between SfM and fusion.
 enum class DepthBlockStep {

@@ -1,5 +1,6 @@
-// `reconstruct --executor slurm` on a real one-node Slurm cluster (scripts/slurm-cluster:
-// munged, slurmctld and slurmd on localhost), against a local run of the same workspace.
+// `reconstruct --executor slurm` and `render --executor slurm` on a real one-node Slurm
+// cluster (scripts/slurm-cluster: munged, slurmctld and slurmd on localhost), against local
+// runs of the same workspace.
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -65,6 +66,19 @@ std::map<std::string, std::string> Outputs(const fs::path& workspace) {
   return files;
 }
 
+// The files a render writes, by name: every image, and render.csv less its timings (the
+// last column).
+std::map<std::string, std::string> RenderedFrames(const fs::path& out) {
+  std::map<std::string, std::string> files;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".png") || name.ends_with(".exr")) files[name] = ReadBytes(entry.path());
+  }
+  std::ifstream csv(out / "render.csv");
+  for (std::string line; std::getline(csv, line);) files["render.csv"] += line.substr(0, line.rfind(',')) + "\n";
+  return files;
+}
+
 nlohmann::json ReadJson(const fs::path& path) {
   std::ifstream file(path);
   return nlohmann::json::parse(file);
@@ -122,6 +136,29 @@ TEST(Slurm, JobArraysOnARealClusterWriteWhatALocalRunWrites) {
                   cluster.Environment());
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_TRUE(Outputs(on_cluster) == expected);
+
+  // A camera path rendered as a job array, 2 frames a task (the last one frame), writes the
+  // local render's images and rows.
+  const fs::path frames_local = dir.Path() / "frames local";
+  const fs::path frames_cluster = dir.Path() / "frames on cluster";
+  const std::string render = "render " + Quote(local.string()) + " --path orbit:5 --out ";
+  const CliResult local_render = RunParallax(render + Quote(frames_local.string()));
+  ASSERT_EQ(local_render.exit_code, 0) << local_render.output;
+  const CliResult cluster_render =
+      RunParallax(render + Quote(frames_cluster.string()) + " --executor slurm --slurm-block-size 2 --slurm-wait",
+                  cluster.Environment());
+  ASSERT_EQ(cluster_render.exit_code, 0) << cluster_render.output;
+  int frame_logs = 0;
+  for (const auto& entry : fs::directory_iterator(frames_cluster / "slurm" / "logs")) {
+    frame_logs += entry.path().filename().string().starts_with("frames-");
+  }
+  EXPECT_EQ(frame_logs, 3);
+  const auto frames = RenderedFrames(frames_local);
+  EXPECT_EQ(frames.size(), 5u * 3 + 1);  // Color, holes and depth of each frame; render.csv.
+  EXPECT_TRUE(RenderedFrames(frames_cluster) == frames);
+  const nlohmann::json report = ReadJson(frames_cluster / "report.json")["render"];
+  EXPECT_EQ(report["blocks"].size(), 3u);
+  EXPECT_EQ(report["stages"].back()["name"], "frames");
 }
 
 // A failed task stops the chain: the jobs after it are cancelled, not left pending, and
