@@ -14,8 +14,8 @@ namespace {
 
 void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path& workspace,
                   bool dry_run) {
-  std::printf("%s: %d photos; matcher: %s; camera: %s\n", dry_run ? "plan" : "reconstruct",
-              summary.images_found, summary.matcher.c_str(), summary.camera_model.c_str());
+  std::printf("%s: %d photos; matcher: %s; mapper: %s; camera: %s\n", dry_run ? "plan" : "reconstruct",
+              summary.images_found, summary.matcher.c_str(), summary.mapper.c_str(), summary.camera_model.c_str());
   for (const StageRecord& stage : summary.stages) {
     if (stage.skipped) {
       std::printf("  %-12s skipped: %s\n", stage.name.c_str(), stage.reason.c_str());
@@ -85,6 +85,15 @@ void RegisterReconstructCommand(CLI::App& app) {
                           "photo with its most similar, from a vocabulary tree built from the "
                           "photos)")
       ->transform(CLI::CheckedTransformer(matchers, CLI::ignore_case));
+  const std::map<std::string, MapperChoice> mappers = {{"auto", MapperChoice::kAuto},
+                                                       {"incremental", MapperChoice::kIncremental},
+                                                       {"hierarchical", MapperChoice::kHierarchical}};
+  command->add_option("--mapper", arguments->options.mapper,
+                      "auto (default): incremental (one model, image by image) up to " +
+                          std::to_string(ReconstructOptions().hierarchical_limit) +
+                          " photos; past that hierarchical (clusters of the match graph mapped "
+                          "apart, then merged)")
+      ->transform(CLI::CheckedTransformer(mappers, CLI::ignore_case));
   command->add_option("--camera-model", arguments->camera_model,
                       "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");
   command->add_option("--intrinsics", arguments->intrinsics,

@@ -75,6 +75,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
           {"mean_track_length", summary.mean_track_length},
           {"mean_reprojection_error_px", summary.mean_reprojection_error_px},
           {"matcher", summary.matcher},
+          {"mapper", summary.mapper},
           {"camera_model", summary.camera_model},
           {"skipped_files", skipped_files},
           {"stages", stages},
@@ -216,6 +217,9 @@ void ReconstructOptions::Check() const {
                                 " is not supported");
   }
   RequireOption(exhaustive_limit >= 2, "ReconstructOptions.exhaustive_limit", exhaustive_limit, ">= 2");
+  RequireOption(hierarchical_limit >= 2, "ReconstructOptions.hierarchical_limit", hierarchical_limit, ">= 2");
+  RequireOption(hierarchical_cluster_images >= 10, "ReconstructOptions.hierarchical_cluster_images",
+                hierarchical_cluster_images, ">= 10");
   RequireOption(sequential_overlap >= 2, "ReconstructOptions.sequential_overlap", sequential_overlap, ">= 2");
   RequireOption(retrieval_images >= 1, "ReconstructOptions.retrieval_images", retrieval_images, ">= 1");
   RequireOption(ordered_share > 0 && ordered_share <= 1, "ReconstructOptions.ordered_share", ordered_share,
@@ -262,6 +266,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                        MatcherFor(options, num_images), progress};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = PlannedMatcher(options, num_images);
+  summary.mapper = DescribeMapper(options, num_images, known.has_value());
 
   const std::string conversions = DescribeConversions(photos, paths);
   if (!conversions.empty()) summary.notes.push_back(conversions);

@@ -32,6 +32,14 @@ enum class MatcherChoice {
   kRetrieval,   // Each image with the images most similar to it in the vocabulary tree.
 };
 
+// How the registered model is grown from the matches.
+enum class MapperChoice {
+  kAuto,          // Incremental up to `hierarchical_limit` images, hierarchical past it.
+  kIncremental,   // COLMAP's mapper: one model, image by image, bundle adjusted as it grows.
+  kHierarchical,  // COLMAP's hierarchical_mapper: overlapping clusters of the match graph
+                  // mapped apart, then merged.
+};
+
 enum class StereoMethod { kPatchMatch, kSgbm };
 
 struct ReconstructOptions {
@@ -53,6 +61,12 @@ struct ReconstructOptions {
   // Above this many images the automatic matcher is sequential or retrieval (docs/scale.md:
   // where exhaustive matching starts to cost more than they do, measured).
   int exhaustive_limit = 75;
+  MapperChoice mapper = MapperChoice::kAuto;
+  // Above this many images the automatic mapper is hierarchical (docs/scale.md: where the
+  // incremental mapper's bundle adjustments start to cost more, measured).
+  int hierarchical_limit = 800;
+  // Most images in one of the hierarchical mapper's clusters.
+  int hierarchical_cluster_images = 100;
   // colmap's SequentialMatching.overlap: each image is matched with the next overlap - 1
   // images in name order (and those a power of two ahead).
   int sequential_overlap = 20;
@@ -90,6 +104,7 @@ struct ReconstructSummary {
   std::vector<StageRecord> stages;
   std::vector<SkippedFile> skipped_files;
   std::string matcher;  // The matcher used, and why.
+  std::string mapper;   // The mapper used, and why.
   std::string camera_model;
   int images_found = 0;
   int images_registered = 0;

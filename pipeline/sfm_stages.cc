@@ -323,11 +323,11 @@ std::string NoInitialPairReason(const fs::path& database, int num_images) {
 
 // Runs the mapper; where it fails for want of a pair to start from and the matches say why,
 // that is bad input (exit 2) rather than a tool failure.
-void RunMapper(const SfmContext& sfm, const std::vector<std::string>& arguments, const std::string& name,
-               int num_images) {
+void RunMapper(const SfmContext& sfm, const std::string& command, const std::vector<std::string>& arguments,
+               const std::string& name, int num_images) {
   const Workspace& paths = sfm.workspace;
   try {
-    sfm.colmap.Run("mapper", arguments, paths.Log(name), name, num_images, sfm.progress);
+    sfm.colmap.Run(command, arguments, paths.Log(name), name, num_images, sfm.progress);
   } catch (const ToolError&) {
     const std::string reason = NoInitialPairReason(paths.Database(), num_images);
     if (reason.empty()) throw;
@@ -592,6 +592,24 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
   return stage;
 }
 
+bool MapsHierarchically(const ReconstructOptions& options, int num_images) {
+  if (options.mapper == MapperChoice::kAuto) return num_images > options.hierarchical_limit;
+  return options.mapper == MapperChoice::kHierarchical;
+}
+
+std::string DescribeMapper(const ReconstructOptions& options, int num_images, bool known) {
+  if (known) return "point_triangulator (known cameras: only the points are triangulated)";
+  const std::string chosen = options.mapper == MapperChoice::kAuto ? ", chosen automatically: " : "";
+  if (!MapsHierarchically(options, num_images)) {
+    return "incremental (one model grown image by image)" + chosen +
+           (chosen.empty() ? "" : "at most " + std::to_string(options.hierarchical_limit) + " images");
+  }
+  return "hierarchical (clusters of at most " + std::to_string(options.hierarchical_cluster_images) +
+         " images mapped apart, then merged)" + chosen +
+         (chosen.empty() ? "" : std::to_string(num_images) + " images, more than " +
+                                    std::to_string(options.hierarchical_limit) + " for one incremental model");
+}
+
 Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
                   std::vector<std::string>& notes) {
   const Workspace& paths = sfm.workspace;
@@ -600,15 +618,18 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       sfm.camera.sharing == CameraSharing::kAll && !sfm.camera.fixed_intrinsics &&
       num_images >= sfm.options.refine_principal_point_min_images;
   Stage stage;
+  const bool hierarchical = !sfm.known && MapsHierarchically(sfm.options, num_images);
   stage.name = sfm.known ? "triangulate" : "mapper";
-  stage.key = Hasher()
-                  .Add(matches_key)
-                  .Add(sfm.camera.fixed_intrinsics)
-                  .Add(refine_principal_point)
-                  .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0)
-                  .Hex();
+  Hasher hasher;
+  hasher.Add(matches_key)
+      .Add(sfm.camera.fixed_intrinsics)
+      .Add(refine_principal_point)
+      .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
+  // The incremental mapper keeps the keys it had before there was a choice.
+  if (hierarchical) hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images));
+  stage.key = hasher.Hex();
   stage.outputs = {paths.RawModel()};
-  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, name = stage.name] {
+  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, name = stage.name] {
     const fs::path models = paths.Models().string() + ".tmp";
     const TemporaryOutput temporary(models);
     RemoveAll(models);
@@ -630,12 +651,20 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       sfm.colmap.Run("point_triangulator", arguments, paths.Log(name), name, num_images,
                      sfm.progress);
     } else {
-      arguments.insert(arguments.end(), {"--output_path", models.string(), "--image_list_path",
-                                         paths.ImageList().string()});
+      arguments.insert(arguments.end(), {"--output_path", models.string()});
+      if (hierarchical) {
+        // The database holds exactly the listed photos, so no image list is needed (nor taken).
+        arguments.insert(arguments.end(), {"--leaf_max_num_images",
+                                           std::to_string(sfm.options.hierarchical_cluster_images),
+                                           "--image_overlap",
+                                           std::to_string(sfm.options.hierarchical_cluster_images / 2)});
+      } else {
+        arguments.insert(arguments.end(), {"--image_list_path", paths.ImageList().string()});
+      }
       if (sfm.camera.fixed_intrinsics) {
         arguments.insert(arguments.end(), fixed_intrinsics.begin(), fixed_intrinsics.end());
       }
-      RunMapper(sfm, arguments, name, num_images);
+      RunMapper(sfm, hierarchical ? "hierarchical_mapper" : "mapper", arguments, name, num_images);
     }
     Replace(models, paths.Models());
     WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);

@@ -74,6 +74,12 @@ MatcherChoice MatcherFor(const ReconstructOptions& options, int num_images);
 // writes what it did into Workspace::MatchedMarker.
 std::string PlannedMatcher(const ReconstructOptions& options, int num_images);
 
+// Whether `num_images` photos are mapped hierarchically (--mapper, or past the limit).
+bool MapsHierarchically(const ReconstructOptions& options, int num_images);
+// report.json's sentence for the mapper, and why (`known`: --known-cameras, which only
+// triangulates).
+std::string DescribeMapper(const ReconstructOptions& options, int num_images, bool known);
+
 // `photos_key` is PhotosStage's key.
 Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key);
 // The vocabulary tree sequential and retrieval matching need, built from the photos' own
