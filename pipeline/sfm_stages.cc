@@ -283,6 +283,18 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
   return note;
 }
 
+// One bundle adjustment of the whole raw model: the hierarchical mapper merges its clusters'
+// models without one, as COLMAP's documentation warns.
+void AdjustMergedModel(const Colmap& colmap, const Workspace& paths, Progress& progress) {
+  const fs::path adjusted = paths.RefinedModelScratch();
+  RemoveAll(adjusted);
+  fs::create_directories(adjusted);
+  colmap.Run("bundle_adjuster", {"--input_path", paths.RawModel().string(), "--output_path", adjusted.string()},
+             paths.Log("adjust"), "adjust", 0, progress);
+  WriteSparseModel(ReadSparseModel(adjusted), paths.RawModel(), SparseFormat::kBinary);
+  RemoveAll(adjusted);
+}
+
 // The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
 std::vector<fs::path> ModelDirs(const Workspace& paths) {
   const fs::path models_dir = paths.Models();
@@ -670,6 +682,8 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
     WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);
     if (refine_principal_point) {
       notes.push_back(RefinePrincipalPoint(sfm.colmap, paths, sfm.options, sfm.progress));
+    } else if (hierarchical) {
+      AdjustMergedModel(sfm.colmap, paths, sfm.progress);
     }
   };
   return stage;

@@ -4,3 +4,4 @@ set_tests_properties(ReconstructCli.PhotosInEveryFormACameraWritesAreReconstruct
 set_tests_properties(ReconstructCli.PhotosOfTwoSizesGetOneCameraPerSize PROPERTIES LABELS "cli;slow")
 set_tests_properties(Slurm.JobArraysOnARealClusterWriteWhatALocalRunWrites PROPERTIES LABELS "cli;slow")
 set_tests_properties(Matching.OrderedPhotosMatchSequentiallyShuffledOnesByRetrieval PROPERTIES LABELS "pipeline;slow")
+set_tests_properties(Mapping.PastTheLimitClustersAreMappedApartAndMerged PROPERTIES LABELS "pipeline;slow")

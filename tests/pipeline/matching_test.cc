@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "colmap/database.h"
+#include "core/atomic_file.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
@@ -98,6 +99,43 @@ TEST(Matching, AnAutomaticChoiceUpToTheLimitIsExhaustiveAndNeedsNoTree) {
   const StageRecord& tree = StageNamed(plan, "vocabulary tree");
   EXPECT_TRUE(tree.skipped);
   EXPECT_NE(tree.reason.find("exhaustive matching"), std::string::npos) << tree.reason;
+}
+
+// Past a hierarchical limit of 10 images the 24 photos are mapped in clusters of at most 10,
+// overlapping by 5, and merged into one model: every photo registered, the rotations a little
+// worse than one incremental model's (as on the plaza at 400 views, docs/scale.md).
+TEST(Mapping, PastTheLimitClustersAreMappedApartAndMerged) {
+  ReconstructOptions options;
+  options.quality = Quality::kFast;
+  options.estimate_depth = false;
+  options.hierarchical_limit = 10;
+  options.hierarchical_cluster_images = 10;
+  SilentProgress progress;
+  const TempDir workspace;
+  const ReconstructSummary summary = Reconstruct(kCourtyard / "images", workspace.Path(), options, progress);
+  EXPECT_NE(summary.mapper.find("hierarchical (clusters of at most 10 images mapped apart, then merged), "
+                                "chosen automatically: 24 images, more than 10"),
+            std::string::npos) << summary.mapper;
+  const std::string log = ReadFileBytes(Workspace(workspace.Path()).Log("mapper"));
+  EXPECT_NE(log.find("Partitioning scene"), std::string::npos);
+  const PoseEvaluation poses = EvaluatePoses(ReadSparseModel(workspace.Path() / "sparse"),
+                                             ReadSparseModel(SceneFolder{kCourtyard}.Training().sparse));
+  EXPECT_EQ(poses.registered, 24);
+  EXPECT_LT(poses.rotation_error_mean_deg, 0.5);
+  EXPECT_LT(summary.mean_reprojection_error_px, 1.0);
+
+  // Forced back to one incremental model, the mapper runs again (another key), and says so.
+  options.mapper = MapperChoice::kIncremental;
+  const ReconstructSummary incremental = Reconstruct(kCourtyard / "images", workspace.Path(), options, progress);
+  EXPECT_EQ(incremental.mapper, "incremental (one model grown image by image)");
+  EXPECT_FALSE(StageNamed(incremental, "mapper").skipped);
+  EXPECT_TRUE(StageNamed(incremental, "matches").skipped);
+  const PoseEvaluation one_model = EvaluatePoses(ReadSparseModel(workspace.Path() / "sparse"),
+                                                 ReadSparseModel(SceneFolder{kCourtyard}.Training().sparse));
+  std::printf("[ measure ] rotation error: hierarchical %.3f deg, incremental %.3f deg\n",
+              poses.rotation_error_mean_deg, one_model.rotation_error_mean_deg);
+  EXPECT_EQ(one_model.registered, 24);
+  EXPECT_LT(one_model.rotation_error_mean_deg, 0.2);
 }
 
 }  // namespace
