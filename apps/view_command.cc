@@ -86,7 +86,7 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
               static_cast<int>(shot.view.camera.width), static_cast<int>(shot.view.camera.height),
               times.median_ms, times.min_ms);
   if (times.moving_median_ms) {
-    std::printf("frame time with the light moving (shadow map re-rendered): median %.1f ms, min %.1f ms\n",
+    std::printf("frame time with the light moving: median %.1f ms, min %.1f ms\n",
                 *times.moving_median_ms, *times.moving_min_ms);
   }
 }
@@ -113,10 +113,12 @@ void RegisterViewCommand(CLI::App& app) {
       ->check(CLI::Range(1.0, 170.0));
   command->add_option("--size", a->size, "image size WxH (default 1280x720; a source camera's own size)");
   const std::map<std::string, ShadowMode> shadows{{"none", ShadowMode::kNone},
+                                                  {"blob", ShadowMode::kBlob},
                                                   {"planar", ShadowMode::kPlanar},
                                                   {"map", ShadowMode::kMap},
-                                                  {"pcf", ShadowMode::kPcf}};
-  command->add_option("--shadows", a->shadows, "none|planar|map|pcf (default pcf)")
+                                                  {"pcf", ShadowMode::kPcf},
+                                                  {"volume", ShadowMode::kVolume}};
+  command->add_option("--shadows", a->shadows, "none|blob|planar|map|pcf|volume (default pcf)")
       ->transform(CLI::CheckedTransformer(shadows, CLI::ignore_case));
   const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
                                                     {"projective", TextureMode::kProjective},

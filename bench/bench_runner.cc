@@ -293,7 +293,7 @@ void Bench::Shadows() {
                       {{"iou_cast", NumberAfter(run.output, "cast shadows alone: ", log)},
                        {"iou", NumberAfter(run.output, "shadow IoU against Embree ray tracing: ", log)},
                        {"ms_still_light", NumberAfter(run.output, "): median ", log)}},
-                      NumberAfter(run.output, "(shadow map re-rendered): median ", log), run.wall_s, run.peak_mb,
+                      NumberAfter(run.output, "light moving: median ", log), run.wall_s, run.peak_mb,
                       false});
     }
   }

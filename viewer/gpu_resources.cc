@@ -169,6 +169,22 @@ Drawable Upload(const std::vector<Vertex>& vertices) {
   return d;
 }
 
+void HomogeneousTriangles::Replace(const std::vector<Eigen::Vector4f>& points) {
+  static_assert(sizeof(Eigen::Vector4f) == 4 * sizeof(float), "uploaded as a packed array");
+  if (vao.Get() == 0) {
+    vao = MakeGlVertexArray();
+    buffer = MakeGlBuffer();
+  }
+  glBindVertexArray(vao.Get());
+  glBindBuffer(GL_ARRAY_BUFFER, buffer.Get());
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(points.size() * sizeof(Eigen::Vector4f)), points.data(),
+               GL_DYNAMIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, sizeof(Eigen::Vector4f), nullptr);
+  glBindVertexArray(0);
+  count = static_cast<GLsizei>(points.size());
+}
+
 GpuMesh UploadMesh(const TriangleMesh& mesh, const std::optional<GroundPlane>& ground) {
   GpuMesh uploaded;
   if (mesh.triangles.empty()) return uploaded;
@@ -207,6 +223,14 @@ GlTexture UploadSrgbTexture(const Image& image) {
   // Bilinear in the nearest mip level: half the texel fetches of trilinear, and nearly the
   // same image.
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_NEAREST);
+  return texture;
+}
+
+GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size) {
+  GlTexture texture = MakeTextureOnScratchUnit();
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, size, size, 0, GL_RED, GL_UNSIGNED_BYTE, texels.data());
+  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
   return texture;
 }
 

@@ -5,6 +5,8 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "geometry/obj.h"
 #include "viewer/gl.h"
 #include "geometry/ground_plane.h"
@@ -36,6 +38,15 @@ struct Drawable {
 
 Drawable Upload(const std::vector<Vertex>& vertices);
 
+// Homogeneous points (4 floats each) as attribute 0, drawn as triangles; `Replace` refills the
+// buffer, e.g. a shadow volume rebuilt for a moved light.
+struct HomogeneousTriangles {
+  GlVertexArray vao;
+  GlBuffer buffer;
+  GLsizei count = 0;
+  void Replace(const std::vector<Eigen::Vector4f>& points);
+};
+
 // A vertex buffer drawn by index.
 struct IndexedMesh {
   GlVertexArray vao;
@@ -60,6 +71,9 @@ void SetTextureParameters(GLenum filter, GLenum wrap);
 // An sRGB texture of an image (values in [0, 1], sRGB-encoded), top row first; sampling returns
 // linear values.
 GlTexture UploadSrgbTexture(const Image& image);
+
+// A single-channel linear texture of `size` x `size` bytes, bilinear, clamped to its edge.
+GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size);
 
 // A depth texture for hardware comparison, with an FBO that renders into it.
 struct DepthTarget {

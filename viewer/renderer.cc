@@ -9,10 +9,12 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "viewer/blob_shadows.h"
 #include "viewer/gl.h"
 #include "viewer/gpu_resources.h"
 #include "viewer/overlays.h"
 #include "viewer/shaders.h"
+#include "viewer/shadow_volume.h"
 #include "viewer/view_math.h"
 #include "core/check.h"
 
@@ -28,6 +30,7 @@ using gpu::Vertex;
 using gpu::kAtlasUnit, gpu::kShadowUnit, gpu::kPhotoUnit, gpu::kProjectorDepthUnit;
 
 constexpr int kMaxProjectors = 3;
+constexpr int kMaxBlobs = 16;
 
 bool HasExtension(std::string_view name) {
   GLint count = 0;
@@ -90,10 +93,19 @@ struct ShadowMapKey {
   }
 };
 
+// What the shadow volume was built for; the same key, the same volume.
+struct ShadowVolumeKey {
+  Eigen::Vector4d light;
+  const TriangleMesh* casters = nullptr;
+  bool operator==(const ShadowVolumeKey& other) const {
+    return light == other.light && casters == other.casters;
+  }
+};
+
 struct SceneRenderer::Impl {
   const ViewerScene& scene;
   bool reverse_z = false;  // glClipControl is available (and then always set to zero-to-one).
-  GlProgram depth, planar, lines;
+  GlProgram depth, planar, volume, blob, lines;
   std::map<std::tuple<int, int, int>, GlProgram> surface_programs;  // By (albedo, shadow mode, PCF radius).
   // What this frame's surface programs need besides the settings.
   Eigen::Matrix4f shadow_from_world = Eigen::Matrix4f::Identity();
@@ -104,6 +116,13 @@ struct SceneRenderer::Impl {
   float ground_tolerance = 0;
   GpuMesh full_mesh, display_mesh;  // display_mesh is empty without a simplified copy.
   const GpuMesh* mesh = &full_mesh;  // This frame's level of detail (shadows and eye alike).
+  const TriangleMesh* cpu_mesh = nullptr;  // The same level of detail on the CPU.
+  gpu::HomogeneousTriangles shadow_volume;
+  std::optional<ShadowVolumeKey> shadow_volume_key;  // Absent until the volume is built.
+  BlobCasters blob_casters;  // The objects on the ground (of the full mesh), when there is one.
+  Drawable blob_quads;       // Two triangles a blob, placed for `blob_light`.
+  std::optional<Eigen::Vector4d> blob_light;
+  GlTexture blob_texture;
   Drawable points, frusta, grid;
   double frustum_depth = 0;  // Scene units.
   std::vector<Eigen::Vector3d> source_centres;
@@ -114,6 +133,8 @@ struct SceneRenderer::Impl {
   EyeTarget eye;
   std::vector<std::string> notes;
   bool planar_note_given = false;
+  bool volume_note_given = false;
+  bool blob_note_given = false;
   bool with_aux = false;       // This frame fills the auxiliary target (Render).
   bool reverse_z_now = false;  // This frame's depth is reverse-Z (cleared to 0, GL_GREATER).
 
@@ -176,6 +197,17 @@ struct SceneRenderer::Impl {
                     const Eigen::Matrix4f& clip_from_world, int shadow_mode, int projectors);
   void DrawPlanarShadows(const ViewCamera& view, const FrameSettings& settings,
                          const Eigen::Matrix4f& clip_from_world, int projectors);
+  void DrawVolumeShadows(const ViewCamera& view, const FrameSettings& settings,
+                         const Eigen::Matrix4f& clip_from_world, int projectors);
+  // Multiplies each blob's texture into the frame on the ground (with a note, once, without a
+  // ground).
+  void DrawBlobShadows(const ViewCamera& view, const FrameSettings& settings, const Eigen::Matrix4f& clip_from_world);
+  // Ground within this distance of the plane receives planar and blob shadows; triangles
+  // reaching higher cast them.
+  float GroundTolerance() const { return 0.01f * scene.FocusRadius(); }
+  static Eigen::Vector4f GroundVector(const GroundPlane& ground) {
+    return Eigen::Vector4d(ground.normal.x(), ground.normal.y(), ground.normal.z(), ground.offset).cast<float>();
+  }
   // Re-renders the shadow map when the light, its size or the mesh changed; returns the
   // surface shader's shadow mode (0 none, 2 map, 3 PCF).
   int UpdateShadowMap(const FrameSettings& settings);
@@ -295,9 +327,9 @@ void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettin
   if (settings.show_mesh && mesh->triangles > 0) {
     // Depth pre-pass: the mesh's depth alone first, then the shaded pass where it matches, so
     // each pixel is shaded once however much the walls and pillars overlap (fragment work
-    // dominates on llvmpipe). Both vertex shaders compute an invariant gl_Position. The planar
-    // shadows' second pass already tests against the finished depth.
-    const bool prepass = shadow_mode != 1;
+    // dominates on llvmpipe). Both vertex shaders compute an invariant gl_Position. The second
+    // passes of planar shadows and shadow volumes already test against the finished depth.
+    const bool prepass = shadow_mode != 1 && shadow_mode != 4;
     if (prepass) {
       glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
       depth.Use();
@@ -331,11 +363,8 @@ void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettin
 void SceneRenderer::Impl::DrawPlanarShadows(const ViewCamera& view, const FrameSettings& settings,
                                        const Eigen::Matrix4f& clip_from_world, int projectors) {
   const GroundPlane& ground = *scene.ground;
-  const Eigen::Vector4f plane(static_cast<float>(ground.normal.x()), static_cast<float>(ground.normal.y()),
-                              static_cast<float>(ground.normal.z()), static_cast<float>(ground.offset));
-  // Ground within this distance of the plane receives planar shadows; triangles reaching
-  // higher cast them.
-  const float tolerance = 0.01f * scene.FocusRadius();
+  const Eigen::Vector4f plane = GroundVector(ground);
+  const float tolerance = GroundTolerance();
   glEnable(GL_STENCIL_TEST);
   glStencilFunc(GL_ALWAYS, 1, 0xff);
   glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
@@ -362,12 +391,102 @@ void SceneRenderer::Impl::DrawPlanarShadows(const ViewCamera& view, const FrameS
   glDisable(GL_STENCIL_TEST);
 }
 
+// Shadow volumes, z-fail ("Carmack's reverse"): count in the stencil the volume's faces that
+// lie behind the visible surface, back faces up and front faces down. The count is the number
+// of casters between the surface and the light whether or not the eye is inside a volume,
+// since it is taken behind the surface, where the volumes are closed (caps at infinity, depth
+// unclipped). Then redraw unlit where the count is not zero.
+void SceneRenderer::Impl::DrawVolumeShadows(const ViewCamera& view, const FrameSettings& settings,
+                                       const Eigen::Matrix4f& clip_from_world, int projectors) {
+  const ShadowVolumeKey key{LightVector(settings.light), cpu_mesh};
+  if (shadow_volume_key != key) {
+    // Casters move away from the light by a thousandth of the scene, so a lit face is not
+    // inside its own volume (the volumes' shadow acne).
+    const float offset = 1e-3f * scene.FocusRadius();
+    shadow_volume.Replace(BuildShadowVolume(*cpu_mesh, key.light, offset).vertices);
+    shadow_volume_key = key;
+  }
+  glEnable(GL_STENCIL_TEST);
+  glStencilMask(0xff);
+  glStencilFunc(GL_ALWAYS, 0, 0xff);
+  glStencilOpSeparate(GL_BACK, GL_KEEP, GL_INCR_WRAP, GL_KEEP);
+  glStencilOpSeparate(GL_FRONT, GL_KEEP, GL_DECR_WRAP, GL_KEEP);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_DEPTH_CLAMP);  // Nothing of the volume is clipped by the near or far plane.
+  volume.Use();
+  volume.Set("u_clip_from_world", clip_from_world);
+  glBindVertexArray(shadow_volume.vao.Get());
+  glDrawArrays(GL_TRIANGLES, 0, shadow_volume.count);
+  glDisable(GL_DEPTH_CLAMP);
+
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glStencilFunc(GL_NOTEQUAL, 0, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glDepthFunc(reverse_z_now ? GL_GEQUAL : GL_LEQUAL);  // Same geometry, same depth: passes.
+  DrawSurfaces(view, settings, clip_from_world, /*volume second pass*/ 4, projectors);
+  glDepthMask(GL_TRUE);
+  glDepthFunc(reverse_z_now ? GL_GREATER : GL_LESS);
+  glDisable(GL_STENCIL_TEST);
+}
+
+// Blob shadows: the ground under each object darkened by a soft round texture (a quad on the
+// ground per blob, multiplied into the color and the visibility), lifted towards the eye by the
+// ground band so that the reconstructed ground's bumps do not hide it; objects nearer than that
+// keep their color.
+void SceneRenderer::Impl::DrawBlobShadows(const ViewCamera& view, const FrameSettings& settings,
+                                     const Eigen::Matrix4f& clip_from_world) {
+  if (!scene.ground) {
+    if (!blob_note_given) notes.push_back("blob shadows skipped: no ground plane was found in the scene");
+    blob_note_given = true;
+    return;
+  }
+  if (blob_texture.Get() == 0) {
+    constexpr int kBlobTextureSize = 64;
+    blob_texture = gpu::UploadGreyTexture(BlobTexture(kBlobTextureSize), kBlobTextureSize);
+    // Objects are what rises five times the ground band above it (a reconstructed ground's
+    // bumps do not join them into one); a footprint wider than a third of the scene is a wall
+    // or a building around it.
+    blob_casters = FindBlobCasters(scene.mesh, *scene.ground, 5 * GroundTolerance(), 0.35f * scene.Radius(),
+                                   kMaxBlobs);
+  }
+  const Eigen::Vector4d light = LightVector(settings.light);
+  if (blob_light != light) {
+    std::vector<Vertex> corners;
+    for (const Blob& b : PlaceBlobs(scene.mesh, blob_casters, *scene.ground, light, GroundTolerance())) {
+      for (const auto& [s, t] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}}) {
+        const Eigen::Vector3f p = b.centre + static_cast<float>(s) * b.axis_u + static_cast<float>(t) * b.axis_v;
+        corners.push_back({{p.x(), p.y(), p.z()}, {}, {static_cast<float>(s), static_cast<float>(t)}, {}});
+      }
+    }
+    blob_quads = Upload(corners);
+    blob_light = light;
+  }
+  glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
+  glBindTexture(GL_TEXTURE_2D, blob_texture.Get());
+  glActiveTexture(GL_TEXTURE0);
+  blob.Use();
+  blob.Set("u_clip_from_world", clip_from_world);
+  blob.Set("u_eye", Eigen::Vector3f(CameraCenter(view.cam_from_world).cast<float>()));
+  blob.Set("u_lift", GroundTolerance());
+  blob.Set("u_blob", gpu::kScratchUnit);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ZERO, GL_SRC_COLOR);
+  glBindVertexArray(blob_quads.vao.Get());
+  glDrawArrays(GL_TRIANGLES, 0, blob_quads.count);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+}
+
 SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
   Impl& r = *impl_;
   r.reverse_z = HasExtension("GL_ARB_clip_control");
   if (r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   r.depth = GlProgram("depth", shaders::kDepthVertex, shaders::kDepthFragment);
   r.planar = GlProgram("planar shadow", shaders::kPlanarVertex, shaders::kPlanarFragment);
+  r.volume = GlProgram("shadow volume", shaders::kVolumeVertex, shaders::kVolumeFragment);
+  r.blob = GlProgram("blob shadow", shaders::kBlobVertex, shaders::kBlobFragment);
   r.lines = GlProgram("lines", shaders::kLineVertex, shaders::kLineFragment);
   r.full_mesh = gpu::UploadMesh(scene.mesh, scene.ground);
   r.display_mesh = gpu::UploadMesh(scene.display_mesh, scene.ground);
@@ -454,7 +573,8 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   const bool reverse_z = r.reverse_z && settings.reverse_z;
   r.reverse_z_now = reverse_z;
   const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
-  r.mesh = &DisplayedMesh(r.scene, width, height) == &r.scene.display_mesh ? &r.display_mesh : &r.full_mesh;
+  r.cpu_mesh = &DisplayedMesh(r.scene, width, height);
+  r.mesh = r.cpu_mesh == &r.scene.display_mesh ? &r.display_mesh : &r.full_mesh;
 
   // 1. Shadow map from the light.
   const int shadow_mode_uniform = r.UpdateShadowMap(settings);
@@ -482,6 +602,15 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
     } else if (!r.planar_note_given) {
       r.notes.push_back("planar shadows skipped: no ground plane was found in the scene");
       r.planar_note_given = true;
+    }
+  } else if (settings.shadows == ShadowMode::kBlob) {
+    r.DrawBlobShadows(view, settings, clip_from_world);
+  } else if (settings.shadows == ShadowMode::kVolume) {
+    if (r.mesh->triangles > 0) {
+      r.DrawVolumeShadows(view, settings, clip_from_world, projectors);
+    } else if (!r.volume_note_given) {
+      r.notes.push_back("shadow volumes skipped: they need a mesh, and there is only a point cloud");
+      r.volume_note_given = true;
     }
   }
   r.lines.Use();

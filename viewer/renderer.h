@@ -22,9 +22,11 @@ namespace parallax {
 
 enum class ShadowMode {
   kNone,
+  kBlob,    // A soft ellipse on the ground under each object, pushed along the light.
   kPlanar,  // Geometry flattened onto the fitted ground along the light, stencil-masked.
   kMap,     // Shadow map, hardware depth comparison (bilinear between 4 texels).
   kPcf,     // Shadow map filtered over (2r+1)^2 texels (tent weights, (2r)^2 bilinear taps).
+  kVolume,  // Shadow volumes counted in the stencil, z-fail (viewer/shadow_volume.h).
 };
 
 enum class TextureMode {

@@ -54,7 +54,7 @@ uniform float u_specular;
 uniform float u_shininess;
 uniform float u_exposure;     // Linear scale, 2^stops.
 
-const int u_shadow_mode = SHADOW_MODE;      // 0 none, 1 planar (second pass), 2 map, 3 pcf
+const int u_shadow_mode = SHADOW_MODE;      // 0 none, 1 planar / 4 volume (second pass), 2 map, 3 pcf
 uniform sampler2DShadow u_shadow_map;
 in vec4 v_shadow_clip;
 uniform vec2 u_ndc_to_depth;  // window depth = ndc.z * x + y
@@ -159,7 +159,9 @@ void main() {
     float height = dot(u_ground.xyz, v_world) + u_ground.w;
     if (abs(height) > u_ground_tolerance) discard;
     visibility = 0.0;
-  } else if (u_shadow_mode >= 2 && n_dot_l > 0.0) {
+  } else if (u_shadow_mode == 4) {
+    visibility = 0.0;  // Second pass of shadow volumes: the stencil passes shadowed pixels alone.
+  } else if ((u_shadow_mode == 2 || u_shadow_mode == 3) && n_dot_l > 0.0) {
     visibility = ShadowVisibility();
   }
 
@@ -233,6 +235,42 @@ void main() {
   // The ground itself (and anything under it) casts no planar shadow onto the ground. The
   // value is constant over a triangle: no fragment of a standing triangle is dropped.
   if (v_height < u_ground_tolerance) discard;
+}
+)";
+
+const char* const kVolumeVertex = R"(#version 330 core
+layout(location = 0) in vec4 a_position;
+uniform mat4 u_clip_from_world;
+void main() { gl_Position = u_clip_from_world * a_position; }
+)";
+
+const char* const kVolumeFragment = R"(#version 330 core
+void main() {}
+)";
+
+const char* const kBlobVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 2) in vec2 a_uv;  // Across the blob: [-1, 1]^2.
+uniform mat4 u_clip_from_world;
+uniform vec3 u_eye;
+uniform float u_lift;  // Towards the eye, so the ground's own bumps do not hide the blob.
+out vec2 v_st;
+void main() {
+  v_st = a_uv;
+  gl_Position = u_clip_from_world * vec4(a_position + u_lift * normalize(u_eye - a_position), 1.0);
+}
+)";
+
+const char* const kBlobFragment = R"(#version 330 core
+in vec2 v_st;
+uniform sampler2D u_blob;
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out vec4 o_aux;
+void main() {
+  // Multiplied into the frame (blending): the color darkens, the visibility with it.
+  float visibility = texture(u_blob, v_st * 0.5 + 0.5).r;
+  o_color = vec4(vec3(visibility), 1.0);
+  o_aux = vec4(visibility, 1.0, 1.0, 1.0);
 }
 )";
 

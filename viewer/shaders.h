@@ -17,6 +17,14 @@ extern const char* const kDepthFragment;
 extern const char* const kPlanarVertex;
 extern const char* const kPlanarFragment;
 
+// Shadow volumes: homogeneous world points (w = 0 at infinity), counted in the stencil only.
+extern const char* const kVolumeVertex;
+extern const char* const kVolumeFragment;
+
+// Blob shadows: a textured quad on the ground per blob, multiplied into the frame.
+extern const char* const kBlobVertex;
+extern const char* const kBlobFragment;
+
 // Colored lines: camera frusta and the ground grid.
 extern const char* const kLineVertex;
 extern const char* const kLineFragment;

@@ -23,9 +23,11 @@ namespace {
 const char* ShadowName(ShadowMode mode) {
   switch (mode) {
     case ShadowMode::kNone: return "none";
+    case ShadowMode::kBlob: return "blob";
     case ShadowMode::kPlanar: return "planar";
     case ShadowMode::kMap: return "map";
     case ShadowMode::kPcf: return "pcf";
+    case ShadowMode::kVolume: return "volume";
   }
   return "?";
 }
@@ -80,6 +82,8 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_2: settings.shadows = ShadowMode::kPlanar; break;
     case GLFW_KEY_3: settings.shadows = ShadowMode::kMap; break;
     case GLFW_KEY_4: settings.shadows = ShadowMode::kPcf; break;
+    case GLFW_KEY_5: settings.shadows = ShadowMode::kVolume; break;
+    case GLFW_KEY_6: settings.shadows = ShadowMode::kBlob; break;
     case GLFW_KEY_T:
       settings.texture = static_cast<TextureMode>((static_cast<int>(settings.texture) + 1) % 3);
       break;
@@ -188,7 +192,7 @@ void WindowOptions::Check() const {
 
 std::string ViewerKeyHelp() {
   return "keys: mouse left drag orbit | right/middle drag pan | wheel zoom\n"
-         "      1 no shadows  2 planar  3 shadow map  4 PCF   [ ] PCF radius\n"
+         "      1 no shadows  2 planar  3 shadow map  4 PCF  5 volumes  6 blob  [ ] PCF radius\n"
          "      T texture atlas/projective/shaded   C cameras  P points  M mesh  G grid\n"
          "      arrows move the light  L point/directional light  + - exposure\n"
          "      N / B next / previous source camera   R reset view   Esc quit\n";

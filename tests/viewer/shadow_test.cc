@@ -8,6 +8,7 @@
 
 #include "tests/viewer/viewer_test_util.h"
 #include "viewer/view_cameras.h"
+#include "viewer/shadow_volume.h"
 #include "viewer/view_math.h"
 
 namespace parallax {
@@ -68,6 +69,91 @@ TEST(ViewerShadows, PlanarShadowsMatchRayTracedMaskOnTheGround) {
                                              [](const ReferencePixel& p) { return std::abs(p.point.z()) < 1e-3; });
   std::printf("[ measure ] planar: ground IoU %.4f over %d pixels\n", ground.iou, ground.compared);
   EXPECT_GE(ground.iou, 0.95);
+}
+
+// Pixels of the frame against the ray-traced reference, all of them and the ground alone.
+void ExpectVolumeMatchesReference(const ViewerScene& scene, const ViewCamera& view, const char* name,
+                                  double min_iou) {
+  SceneRenderer renderer(scene);
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, kLight);
+  const FrameResult result = renderer.Render(view, ShadowSettings(ShadowMode::kVolume, kLight));
+  MaybeSave(name, result);
+  const MaskComparison all = CompareShadowMasks(reference, result.aux);
+  const MaskComparison cast = CompareCastShadows(reference, result.aux);
+  std::printf("[ measure ] %s: IoU %.4f (cast shadows alone %.4f) over %d pixels, shadowed ref %d / rendered %d\n",
+              name, all.iou, cast.iou, all.compared, all.reference_shadowed, all.rendered_shadowed);
+  EXPECT_GE(all.iou, min_iou) << name;
+  EXPECT_GE(cast.iou, min_iou) << name;
+  EXPECT_GT(cast.reference_shadowed, 1000) << "the view must show a real cast shadow";
+  EXPECT_GT(all.compared - all.reference_shadowed, 1000) << "and lit surfaces";
+}
+
+TEST(ViewerShadows, ShadowVolumesMatchRayTracedMask) {
+  EnsureGlContext();
+  const ViewerScene scene = BoxOnGround();
+  ExpectVolumeMatchesReference(scene, TestView(scene), "shadow_volume", 0.99);
+}
+
+// The lecture's warning: counting the volume faces in front of the surface (z-pass) goes wrong
+// once the eye is inside a volume. z-fail counts behind it and does not care.
+TEST(ViewerShadows, ShadowVolumesStayRightWithTheEyeInsideAVolume) {
+  EnsureGlContext();
+  const ViewerScene scene = BoxOnGround();
+  // 0.3 above the ground on the way of the light from the box's top centre, beside the box:
+  // inside its shadow volume, looking out over the ground, partly in the box's shadow.
+  const Eigen::Vector3d eye = Eigen::Vector3d(0.5, 0.2, 2) + 2.125 * Eigen::Vector3d(-0.5, -0.3, -0.8);
+  ViewCamera view;
+  view.camera = ViewerCamera(640, 480, 90);
+  view.cam_from_world = LookAt(eye, {-1.5, -1.2, 0}, {0, 0, 1});
+  view.near = 0.01;
+  const MeshRaycaster raycaster(scene.mesh.vertices, scene.mesh.triangles);
+  ASSERT_FALSE(raycaster.Unoccluded({eye.cast<float>()}, (-kLight).cast<float>(), 100)[0])
+      << "the eye must be in the box's shadow";
+  ASSERT_TRUE(raycaster.Unoccluded({eye.cast<float>()}, Eigen::Vector3f(0, 0, 1), 100)[0]) << "outside the box";
+  ExpectVolumeMatchesReference(scene, view, "shadow_volume_eye_inside", 0.99);
+}
+
+// Every triangle turned to face the light, interior edges cancelled: a closed box lit from
+// straight above casts its top and its bottom (4 caps), extrudes each of their 4 outer edges
+// (8), and its walls, edge-on, nothing. A lamp above it sees the walls at a slant: all 12
+// triangles cast, each with its image at infinity.
+TEST(ViewerShadows, ShadowVolumeExtrudesOnlyTheSilhouette) {
+  const TriangleMesh box = TessellateObject(Box({0, 0, 1}, {2, 2, 2}));
+  ASSERT_EQ(box.triangles.size(), 12u);
+  const ShadowVolume sun = BuildShadowVolume(box, {0, 0, 1, 0}, 0.0f);
+  EXPECT_EQ(sun.caps, 4);
+  EXPECT_EQ(sun.silhouette_edges, 8);
+  EXPECT_EQ(sun.vertices.size(), 3u * (4 + 8));
+  const ShadowVolume lamp = BuildShadowVolume(box, {0, 0, 100, 1}, 0.0f);
+  EXPECT_EQ(lamp.caps, 2 * 12);
+  for (const Eigen::Vector4f& v : lamp.vertices) ASSERT_TRUE(v.allFinite());
+}
+
+// A blob is the shadow's rough place and size on the ground, nothing more: it must overlap the
+// true shadow more than it misses, and darken nothing above the ground (no self-shadowing).
+TEST(ViewerShadows, BlobShadowLiesOnTheGroundWhereTheShadowFalls) {
+  EnsureGlContext();
+  const ViewerScene scene = BoxOnGround();
+  SceneRenderer renderer(scene);
+  const ViewCamera view = TestView(scene);
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, kLight);
+  const FrameResult result = renderer.Render(view, ShadowSettings(ShadowMode::kBlob, kLight));
+  MaybeSave("shadow_blob", result);
+  const auto on_ground = [](const ReferencePixel& p) { return std::abs(p.point.z()) < 1e-3; };
+  const MaskComparison ground = CompareShadowMasks(reference, result.aux, on_ground);
+  int off_ground_darkened = 0;
+  for (int y = 0; y < result.aux.Height(); ++y) {
+    for (int x = 0; x < result.aux.Width(); ++x) {
+      const ReferencePixel& ref = reference[static_cast<size_t>(y) * 640 + x];
+      // Above the band the renderer counts as ground (1% of the focus radius, < 0.05 here).
+      off_ground_darkened += ref.hit && ref.point.z() > 0.1 && result.aux.At(x, y, 0) < 1.0f;
+    }
+  }
+  std::printf("[ measure ] blob: ground IoU %.4f, shadowed ref %d / rendered %d; above the ground darkened %d\n",
+              ground.iou, ground.reference_shadowed, ground.rendered_shadowed, off_ground_darkened);
+  EXPECT_GT(ground.rendered_shadowed, ground.reference_shadowed / 4);
+  EXPECT_GE(ground.iou, 0.5);
+  EXPECT_EQ(off_ground_darkened, 0);
 }
 
 TEST(ViewerShadows, PlanarShadowsAreSkippedWithANoteWithoutAGround) {
