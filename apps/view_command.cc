@@ -30,7 +30,7 @@ struct ViewArguments {
   std::string size;  // "WxH"
   std::string light = "45,50";  // Azimuth, elevation (degrees) of a directional light.
   std::string point_light;      // "x,y,z" (world): a point light instead.
-  ShadowMode shadows = ShadowMode::kPcf;
+  std::string shadows = "auto";
   TextureMode texture = TextureMode::kAtlas;
   FrameSettings settings;
   bool no_cameras = false;
@@ -41,8 +41,17 @@ struct ViewArguments {
 
 FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
   FrameSettings settings = a.settings;
-  settings.shadows = a.shadows;
   settings.texture = a.texture;
+  const std::map<std::string, ShadowMode> modes{{"none", ShadowMode::kNone},  {"blob", ShadowMode::kBlob},
+                                                {"planar", ShadowMode::kPlanar}, {"map", ShadowMode::kMap},
+                                                {"pcf", ShadowMode::kPcf},     {"volume", ShadowMode::kVolume}};
+  if (a.shadows != "auto") {
+    settings.shadows = modes.at(a.shadows);
+  } else {
+    const ShadowChoice choice = ChooseShadows(scene, a.texture);
+    settings.shadows = choice.mode;
+    std::printf("shadows: %s (--shadows auto)\n", choice.reason.c_str());
+  }
   settings.show_cameras = !a.no_cameras;
   settings.show_grid = !a.no_grid;
   if (!a.point_light.empty()) {
@@ -67,18 +76,30 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
   for (const std::string& note : shot.notes) std::fprintf(stderr, "note: %s\n", note.c_str());
   std::printf("wrote %s (%dx%d, %.0f ms)\n", a.screenshot.string().c_str(), shot.frame.color.Width(),
               shot.frame.color.Height(), shot.ms);
+  if (settings.shadows != ShadowMode::kNone) {
+    std::printf("shadow memory: %.2f MB\n", static_cast<double>(shot.shadow_bytes) / (1 << 20));
+  }
   if (shot.display_mesh) {
     std::printf("level of detail: the display mesh, %zu of %zu triangles\n", shot.drawn->triangles.size(),
                 scene.mesh.triangles.size());
   }
   if (a.shadow_iou) {
-    const ShadowAccuracy accuracy = MeasureShadowAccuracy(*shot.drawn, shot.view, settings, shot.frame);
+    // The ground band of planar and blob shadows: 1% of the focus radius.
+    const ShadowAccuracy accuracy = MeasureShadowAccuracy(*shot.drawn, shot.view, settings, shot.frame, scene.ground,
+                                                          0.01 * scene.FocusRadius());
     const MaskComparison& mask = accuracy.all;
     const MaskComparison& cast = accuracy.cast;
     std::printf("shadow IoU against Embree ray tracing: %.4f (%d rendered, %d ray-traced shadowed of %d pixels); "
                 "cast shadows alone: %.4f (%d / %d of %d pixels facing the light)\n",
                 mask.iou, mask.rendered_shadowed, mask.reference_shadowed, mask.compared, cast.iou,
                 cast.rendered_shadowed, cast.reference_shadowed, cast.compared);
+    if (accuracy.on_ground) {
+      std::printf("cast shadows on the ground: %.4f (%d / %d of %d pixels); on the objects: %.4f (%d / %d of %d pixels)\n",
+                  accuracy.on_ground->iou, accuracy.on_ground->rendered_shadowed,
+                  accuracy.on_ground->reference_shadowed, accuracy.on_ground->compared, accuracy.on_objects->iou,
+                  accuracy.on_objects->rendered_shadowed, accuracy.on_objects->reference_shadowed,
+                  accuracy.on_objects->compared);
+    }
   }
   if (!shot.times) return;
   const FrameTimes& times = *shot.times;
@@ -112,14 +133,10 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_option("--fov", a->fov_deg, "orbit camera's horizontal field of view (degrees, default 50)")
       ->check(CLI::Range(1.0, 170.0));
   command->add_option("--size", a->size, "image size WxH (default 1280x720; a source camera's own size)");
-  const std::map<std::string, ShadowMode> shadows{{"none", ShadowMode::kNone},
-                                                  {"blob", ShadowMode::kBlob},
-                                                  {"planar", ShadowMode::kPlanar},
-                                                  {"map", ShadowMode::kMap},
-                                                  {"pcf", ShadowMode::kPcf},
-                                                  {"volume", ShadowMode::kVolume}};
-  command->add_option("--shadows", a->shadows, "none|blob|planar|map|pcf|volume (default pcf)")
-      ->transform(CLI::CheckedTransformer(shadows, CLI::ignore_case));
+  command->add_option("--shadows", a->shadows,
+                      "auto|none|blob|planar|map|pcf|volume (default auto: none for projected photos, "
+                      "volume for a mesh of up to 4000 triangles, else pcf; it says which)")
+      ->transform(CLI::IsMember({"auto", "none", "blob", "planar", "map", "pcf", "volume"}, CLI::ignore_case));
   const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
                                                     {"projective", TextureMode::kProjective},
                                                     {"shaded", TextureMode::kShaded}};

@@ -1,5 +1,6 @@
 #include "eval/shadow_reference.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <Eigen/Geometry>
@@ -91,19 +92,29 @@ MaskComparison CompareShadowMasks(const std::vector<ReferencePixel>& reference, 
       [&](const ReferencePixel& pixel) { return !only || only(pixel); });
 }
 
-MaskComparison CompareCastShadows(const std::vector<ReferencePixel>& reference, const Image& aux) {
+MaskComparison CompareCastShadows(const std::vector<ReferencePixel>& reference, const Image& aux,
+                                  const std::function<bool(const ReferencePixel&)>& only) {
   return CompareMasks(
       reference, aux, [&](int x, int y) { return aux.At(x, y, 0) < 0.5f; },
-      [](const ReferencePixel& pixel) { return !pixel.facing_away; });
+      [&](const ReferencePixel& pixel) { return !pixel.facing_away && (!only || only(pixel)); });
 }
 
 ShadowAccuracy MeasureShadowAccuracy(const TriangleMesh& drawn, const ViewCamera& view,
-                                     const FrameSettings& settings, const FrameResult& frame) {
+                                     const FrameSettings& settings, const FrameResult& frame,
+                                     const std::optional<GroundPlane>& ground, double ground_band) {
   if (settings.light.type != LightKind::kDirectional || drawn.triangles.empty()) {
     throw BadInputError("--shadow-iou needs a directional light and a mesh");
   }
   const std::vector<ReferencePixel> reference = ReferenceShadows(drawn, view, settings.light.direction);
-  return {CompareShadowMasks(reference, frame.aux), CompareCastShadows(reference, frame.aux)};
+  ShadowAccuracy accuracy{CompareShadowMasks(reference, frame.aux), CompareCastShadows(reference, frame.aux), {}, {}};
+  if (ground) {
+    const auto on_ground = [&](const ReferencePixel& p) {
+      return std::abs(ground->SignedDistance(p.point)) <= ground_band;
+    };
+    accuracy.on_ground = CompareCastShadows(reference, frame.aux, on_ground);
+    accuracy.on_objects = CompareCastShadows(reference, frame.aux, [&](const ReferencePixel& p) { return !on_ground(p); });
+  }
+  return accuracy;
 }
 
 }  // namespace parallax

@@ -3,11 +3,13 @@
 // view sees and whether the light reaches it, and the intersection over union of the renderer's
 // shadow mask with it. Used by the viewer tests, `parallax view --shadow-iou` and the bench.
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "core/image.h"
+#include "geometry/ground_plane.h"
 #include "geometry/obj.h"
 #include "viewer/renderer.h"
 
@@ -49,16 +51,23 @@ MaskComparison CompareShadowMasks(const std::vector<ReferencePixel>& reference, 
 // shadow map and the ray tracer find the way to the light blocked. On a reconstructed mesh the
 // many small faces that turn from the light make the full mask measure the mesh's noise and
 // its shading normals more than the shadow map.
-MaskComparison CompareCastShadows(const std::vector<ReferencePixel>& reference, const Image& aux);
+MaskComparison CompareCastShadows(const std::vector<ReferencePixel>& reference, const Image& aux,
+                                  const std::function<bool(const ReferencePixel&)>& only = {});
 
 struct ShadowAccuracy {
   MaskComparison all;   // Every shadowed pixel.
   MaskComparison cast;  // Cast shadows alone (CompareCastShadows).
+  // With a ground plane, the cast shadows split: those falling on the ground (shadows on other
+  // objects, in the lecture's words) and on what stands on it (objects shadowing themselves).
+  std::optional<MaskComparison> on_ground, on_objects;
 };
 
-// A rendered frame's shadow mask against Embree's exact one for the mesh it drew. Throws
-// BadInputError without a directional light or a mesh.
+// A rendered frame's shadow mask against Embree's exact one for the mesh it drew; the ground is
+// what lies within `ground_band` of `ground`. Throws BadInputError without a directional light
+// or a mesh.
 ShadowAccuracy MeasureShadowAccuracy(const TriangleMesh& drawn, const ViewCamera& view,
-                                     const FrameSettings& settings, const FrameResult& frame);
+                                     const FrameSettings& settings, const FrameResult& frame,
+                                     const std::optional<GroundPlane>& ground = std::nullopt,
+                                     double ground_band = 0);
 
 }  // namespace parallax

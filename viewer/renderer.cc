@@ -31,6 +31,7 @@ using gpu::kAtlasUnit, gpu::kShadowUnit, gpu::kPhotoUnit, gpu::kProjectorDepthUn
 
 constexpr int kMaxProjectors = 3;
 constexpr int kMaxBlobs = 16;
+constexpr int kBlobTextureSize = 64;
 
 bool HasExtension(std::string_view name) {
   GLint count = 0;
@@ -64,6 +65,23 @@ const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int heigh
   constexpr size_t kPixelsPerTriangle = 16;
   const bool too_fine = scene.mesh.triangles.size() * kPixelsPerTriangle > static_cast<size_t>(width) * static_cast<size_t>(height);
   return too_fine && !scene.display_mesh.triangles.empty() ? scene.display_mesh : scene.mesh;
+}
+
+ShadowChoice ChooseShadows(const ViewerScene& scene, TextureMode texture) {
+  // On a real facade's 32k-triangle display mesh a third of the edges are silhouettes, and
+  // the volume cost three PCF frames; up to this many triangles it costs about one.
+  constexpr size_t kVolumeTriangles = 4000;
+  if (texture == TextureMode::kProjective) {
+    return {ShadowMode::kNone, "none: the photos are shown as captured, with their own shadows"};
+  }
+  const TriangleMesh& mesh = scene.display_mesh.triangles.empty() ? scene.mesh : scene.display_mesh;
+  if (mesh.triangles.empty()) return {ShadowMode::kPcf, "pcf: a point cloud casts shadows into a shadow map only"};
+  const std::string triangles = std::to_string(mesh.triangles.size()) + " triangles";
+  if (mesh.triangles.size() <= kVolumeTriangles) {
+    return {ShadowMode::kVolume, "volume: exact shadows, and the mesh is small (" + triangles + ")"};
+  }
+  return {ShadowMode::kPcf, "pcf: the mesh is too large for shadow volumes to be cheap (" + triangles + ", more than " +
+                                std::to_string(kVolumeTriangles) + ")"};
 }
 
 std::vector<int> NearestSourceViews(const ViewerScene& scene, const Eigen::Vector3d& eye, int count) {
@@ -442,7 +460,6 @@ void SceneRenderer::Impl::DrawBlobShadows(const ViewCamera& view, const FrameSet
     return;
   }
   if (blob_texture.Get() == 0) {
-    constexpr int kBlobTextureSize = 64;
     blob_texture = gpu::UploadGreyTexture(BlobTexture(kBlobTextureSize), kBlobTextureSize);
     // Objects are what rises five times the ground band above it (a reconstructed ground's
     // bumps do not join them into one); a footprint wider than a third of the scene is a wall
@@ -509,6 +526,20 @@ SceneRenderer::~SceneRenderer() = default;
 void SceneRenderer::Finish() const { glFinish(); }
 
 bool SceneRenderer::UsesReverseZ() const { return impl_->reverse_z; }
+
+size_t SceneRenderer::ShadowBytes(ShadowMode mode) const {
+  const Impl& r = *impl_;
+  switch (mode) {
+    case ShadowMode::kMap:
+    case ShadowMode::kPcf: return static_cast<size_t>(r.shadow.width) * static_cast<size_t>(r.shadow.height) * sizeof(float);
+    case ShadowMode::kVolume: return static_cast<size_t>(r.shadow_volume.count) * sizeof(Eigen::Vector4f);
+    case ShadowMode::kBlob:
+      return r.blob_texture.Get() == 0 ? 0 : kBlobTextureSize * kBlobTextureSize + static_cast<size_t>(r.blob_quads.count) * sizeof(Vertex);
+    case ShadowMode::kNone:
+    case ShadowMode::kPlanar: return 0;
+  }
+  return 0;
+}
 
 std::vector<std::string> SceneRenderer::TakeNotes() { return std::exchange(impl_->notes, {}); }
 

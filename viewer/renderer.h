@@ -103,6 +103,10 @@ class SceneRenderer {
   void Finish() const;
 
   bool UsesReverseZ() const;
+  // GPU memory the last frame's shadow method held for itself (bytes): the shadow map, the
+  // volume's vertices, the blob texture and quads; planar shadows and volumes' stencil share
+  // the frame's depth-stencil buffer.
+  size_t ShadowBytes(ShadowMode mode) const;
   // Messages for the user, e.g. that planar shadows are skipped without a ground plane.
   std::vector<std::string> TakeNotes();
 
@@ -115,6 +119,15 @@ class SceneRenderer {
 // if scene.mesh would give a triangle fewer than 16 pixels, else scene.mesh. Finer triangles
 // cost llvmpipe vertex and setup work without adding detail the atlas does not already show.
 const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int height);
+
+// What `--shadows auto` draws for a scene, and why: nothing when the photos are projected as
+// captured (they hold their own shadows), a shadow map for a point cloud, shadow volumes (exact)
+// for a mesh small enough that their silhouettes cost little fill, else PCF.
+struct ShadowChoice {
+  ShadowMode mode = ShadowMode::kPcf;
+  std::string reason;
+};
+ShadowChoice ChooseShadows(const ViewerScene& scene, TextureMode texture);
 
 // The source views to project for an eye at `eye`: up to `count` indices into scene.sources,
 // with a photo on disk, nearest by the angle their centres make with the eye at the scene

@@ -74,6 +74,7 @@ Screenshot TakeScreenshot(const ViewerScene& scene, const FrameSettings& setting
   shot.frame = renderer.Render(shot.view, settings);
   shot.ms = MsSince(start);
   shot.notes = renderer.TakeNotes();
+  shot.shadow_bytes = renderer.ShadowBytes(settings.shadows);
   WriteImage(options.path, shot.frame.color, PixelFormat::kUint8);  // Atomic: temporary + rename.
   shot.drawn = &DisplayedMesh(scene, shot.frame.color.Width(), shot.frame.color.Height());
   shot.display_mesh = shot.drawn == &scene.display_mesh;

@@ -37,6 +37,7 @@ struct Screenshot {
   bool display_mesh = false;            // Whether that is the display copy.
   double ms = 0;                        // The first frame, shader compilation included.
   std::vector<std::string> notes;       // What the renderer left out, and why.
+  size_t shadow_bytes = 0;              // SceneRenderer::ShadowBytes after the frame.
   std::optional<FrameTimes> times;      // With options.timed_frames > 0.
 };
 

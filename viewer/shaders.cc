@@ -156,8 +156,9 @@ void main() {
   float visibility = 1.0;
   if (u_shadow_mode == 1) {
     // Second pass of planar shadows: redraw only where the ground lies under a flattened caster.
+    // Ground is near the plane and faces along its normal: not the foot of a wall.
     float height = dot(u_ground.xyz, v_world) + u_ground.w;
-    if (abs(height) > u_ground_tolerance) discard;
+    if (abs(height) > u_ground_tolerance || abs(dot(n, u_ground.xyz)) < 0.7) discard;
     visibility = 0.0;
   } else if (u_shadow_mode == 4) {
     visibility = 0.0;  // Second pass of shadow volumes: the stencil passes shadowed pixels alone.

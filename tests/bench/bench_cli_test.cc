@@ -67,6 +67,9 @@ TEST(BenchCli, SmallSceneReportsEveryStageAgainstItsBaselines) {
   // 0.91 at 512^2 and 0.95 at 4096^2); a finer map is closer.
   EXPECT_GT(Cell(csv, "shadows,parallax,pcf r=1 2048^2", "iou_cast"), 0.85);
   EXPECT_GT(Cell(csv, "shadows,parallax,map 4096^2", "iou_cast"), Cell(csv, "shadows,parallax,map 512^2", "iou_cast"));
+  // Shadow volumes are exact up to the pixel grid: on the ground at least as right as any map.
+  EXPECT_GT(Cell(csv, "shadows,parallax,volume", "iou_ground"), 0.95);
+  EXPECT_GE(Cell(csv, "shadows,parallax,volume", "iou_cast"), Cell(csv, "shadows,parallax,map 512^2", "iou_cast"));
   // SfM: COLMAP's automatic_reconstructor ran and was evaluated.
   EXPECT_GT(Cell(csv, "sfm,colmap,", "rotation_error_deg"), 0);
   EXPECT_GT(Cell(csv, "sfm,colmap,", "peak_mb"), 10);

@@ -156,6 +156,23 @@ TEST(ViewerShadows, BlobShadowLiesOnTheGroundWhereTheShadowFalls) {
   EXPECT_EQ(off_ground_darkened, 0);
 }
 
+// --shadows auto leaves out what the picture does not need and says why.
+TEST(ViewerShadows, AutomaticShadowsFitTheScene) {
+  ViewerScene scene = BoxOnGround();
+  const ShadowChoice small = ChooseShadows(scene, TextureMode::kAtlas);
+  EXPECT_EQ(small.mode, ShadowMode::kVolume) << small.reason;
+  EXPECT_NE(small.reason.find("exact"), std::string::npos) << small.reason;
+  const ShadowChoice photos = ChooseShadows(scene, TextureMode::kProjective);
+  EXPECT_EQ(photos.mode, ShadowMode::kNone) << photos.reason;
+  EXPECT_NE(photos.reason.find("their own shadows"), std::string::npos) << photos.reason;
+  while (scene.mesh.triangles.size() <= 4000) scene.mesh.triangles.push_back(scene.mesh.triangles.front());
+  const ShadowChoice large = ChooseShadows(scene, TextureMode::kAtlas);
+  EXPECT_EQ(large.mode, ShadowMode::kPcf) << large.reason;
+  EXPECT_NE(large.reason.find("4001 triangles"), std::string::npos) << large.reason;
+  scene.mesh.triangles.clear();
+  EXPECT_EQ(ChooseShadows(scene, TextureMode::kAtlas).mode, ShadowMode::kPcf);
+}
+
 TEST(ViewerShadows, PlanarShadowsAreSkippedWithANoteWithoutAGround) {
   EnsureGlContext();
   // A lone box: no plane holds 15% of its surface samples within tolerance... except a face;
