@@ -117,7 +117,10 @@ std::vector<uint8_t> BlobTexture(int size) {
     for (int x = 0; x < size; ++x) {
       const double s = 2 * (x + 0.5) / size - 1, t = 2 * (y + 0.5) / size - 1;
       const double r = std::clamp((std::hypot(s, t) - 2.0 / 3) * 3, 0.0, 1.0);
-      const double visibility = r * r * (3 - 2 * r);  // Smoothstep from 2/3 to 1 of the radius.
+      // A shadow keeps the ambient light: about a third of the lit color in the core, then a
+      // smoothstep from 2/3 to 1 of the radius.
+      constexpr double kCore = 0.35;
+      const double visibility = kCore + (1 - kCore) * r * r * (3 - 2 * r);
       texels[static_cast<size_t>(y) * static_cast<size_t>(size) + static_cast<size_t>(x)] =
           static_cast<uint8_t>(std::lround(255 * visibility));
     }

@@ -40,8 +40,10 @@ struct Blob {
 std::vector<Blob> PlaceBlobs(const TriangleMesh& mesh, const BlobCasters& casters, const GroundPlane& ground,
                              const Eigen::Vector4d& light, float min_radius);
 
-// The blob's texture, `size` x `size` light visibilities (0 in the core, 1 outside the
-// inscribed circle), row by row: dark to two thirds of the radius, then a smooth rim.
+// The blob's texture, `size` x `size` light visibilities (0.35 in the core, 1 outside the
+// inscribed circle), row by row: dark to two thirds of the radius, then a smooth rim. It is
+// multiplied into the frame, so the core keeps about the share of the color a real shadow
+// keeps in ambient light.
 std::vector<uint8_t> BlobTexture(int size);
 
 }  // namespace parallax
