@@ -23,6 +23,7 @@ namespace {
 struct ViewArguments {
   std::filesystem::path workspace;
   std::filesystem::path screenshot;
+  std::filesystem::path screenshot_dir = ".";  // The window's S key.
   std::string camera;
   std::optional<double> orbit_deg;
   std::optional<double> elevation_deg;  // Default: the source cameras' elevation, else 30.
@@ -155,6 +156,8 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_flag("--shadow-iou", a->shadow_iou,
                     "with --screenshot: compare its shadow mask with one ray-traced by Embree for the same "
                     "mesh and light, and print the intersection over union");
+  command->add_option("--screenshot-dir", a->screenshot_dir,
+                      "in the window: where the S key writes view-<n>.png (default: the current folder)");
   command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {
@@ -172,6 +175,10 @@ void RegisterViewCommand(CLI::App& app) {
     options.fov_deg = a->fov_deg;
     options.azimuth_deg = a->orbit_deg.value_or(30);
     options.elevation_deg = a->elevation_deg;
+    const std::vector<double> light = ParseNumbers(a->light, 2, "--light");
+    options.light_azimuth_deg = light[0];
+    options.light_elevation_deg = light[1];
+    options.screenshot_dir = a->screenshot_dir;
     RunViewerWindow(scene, settings, options, SourceIndex(scene, a->camera),
                     [](const std::string& text) {
                       std::fputs(text.c_str(), stdout);

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "core/image.h"
 #include "core/check.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
@@ -54,6 +55,7 @@ struct WindowState {
   bool dragging_orbit = false, dragging_pan = false;
   double last_x = 0, last_y = 0;
   double fov_deg = 50;
+  bool screenshot_requested = false;  // The S key: write the next frame to a PNG.
 };
 
 WindowState* State(GLFWwindow* window) {
@@ -87,6 +89,7 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_T:
       settings.texture = static_cast<TextureMode>((static_cast<int>(settings.texture) + 1) % 3);
       break;
+    case GLFW_KEY_S: s.screenshot_requested = true; break;
     case GLFW_KEY_C: settings.show_cameras = !settings.show_cameras; break;
     case GLFW_KEY_P: settings.points_with_mesh = settings.show_points = !settings.show_points; break;
     case GLFW_KEY_M: settings.show_mesh = !settings.show_mesh; break;
@@ -150,6 +153,22 @@ void OnScroll(GLFWwindow* window, double, double dy) {
   s.distance *= std::pow(0.9, dy);
 }
 
+// What the window shows, for the user (and the window test): modes, view, light, frame time.
+std::string WindowTitle(const WindowState& s, double frame_ms) {
+  char view[96];
+  if (s.source) {
+    std::snprintf(view, sizeof(view), "camera %s", s.scene->sources[*s.source].name.c_str());
+  } else {
+    std::snprintf(view, sizeof(view), "view az %.0f el %.0f dist %.3g", s.azimuth_deg, s.elevation_deg, s.distance);
+  }
+  char title[320];
+  std::snprintf(title, sizeof(title), "parallax view | shadows %s | texture %s | %s | %s light az %.0f el %.0f | %.1f ms",
+                ShadowName(s.settings.shadows), TextureName(s.settings.texture), view,
+                s.settings.light.type == LightKind::kPoint ? "point" : "directional", s.light_azimuth_deg,
+                s.light_elevation_deg, frame_ms);
+  return title;
+}
+
 ViewCamera CurrentView(const WindowState& s, int width, int height) {
   if (s.source) return ScaledSourceViewCamera(s.scene->sources[*s.source], width, height);
   return ViewCamera{ViewerCamera(width, height, s.fov_deg),
@@ -195,7 +214,7 @@ std::string ViewerKeyHelp() {
          "      1 no shadows  2 planar  3 shadow map  4 PCF  5 volumes  6 blob  [ ] PCF radius\n"
          "      T texture atlas/projective/shaded   C cameras  P points  M mesh  G grid\n"
          "      arrows move the light  L point/directional light  + - exposure\n"
-         "      N / B next / previous source camera   R reset view   Esc quit\n";
+         "      N / B next / previous source camera   R reset view   S screenshot   Esc quit\n";
 }
 
 void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const WindowOptions& options,
@@ -223,6 +242,8 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
   state.distance = state.home.distance;
   state.elevation_deg = state.home.elevation_deg;
   state.source = start_source;
+  state.light_azimuth_deg = options.light_azimuth_deg;
+  state.light_elevation_deg = options.light_elevation_deg;
   UpdateLight(state);
   glfwSetWindowUserPointer(glfw.window, &state);
   glfwSetKeyCallback(glfw.window, OnKey);
@@ -232,6 +253,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
   log(ViewerKeyHelp());
 
   double smoothed_ms = 0;
+  int screenshots = 0;
   while (!glfwWindowShouldClose(glfw.window)) {
     int width = 0, height = 0;
     glfwGetFramebufferSize(glfw.window, &width, &height);
@@ -241,12 +263,15 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
       glFinish();  // So the time measures the frame, not the command submission.
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       smoothed_ms = smoothed_ms == 0 ? ms : 0.9 * smoothed_ms + 0.1 * ms;
+      if (state.screenshot_requested) {
+        state.screenshot_requested = false;
+        const std::filesystem::path path =
+            options.screenshot_dir / ("view-" + std::to_string(++screenshots) + ".png");
+        WriteImage(path, renderer.Render(CurrentView(state, width, height), state.settings).color, PixelFormat::kUint8);
+        log("wrote " + path.string() + "\n");
+      }
       for (const std::string& note : renderer.TakeNotes()) log(note + "\n");
-      char title[256];
-      std::snprintf(title, sizeof(title), "parallax view | shadows %s | texture %s | light %s | %.1f ms",
-                    ShadowName(state.settings.shadows), TextureName(state.settings.texture),
-                    state.settings.light.type == LightKind::kPoint ? "point" : "directional", smoothed_ms);
-      glfwSetWindowTitle(glfw.window, title);
+      glfwSetWindowTitle(glfw.window, WindowTitle(state, smoothed_ms).c_str());
       glfwSwapBuffers(glfw.window);
     }
     glfwPollEvents();

@@ -1,7 +1,9 @@
 #pragma once
 // The interactive viewer: a GLFW window drawing through the same SceneRenderer as the offscreen
 // path, with a trackball (orbit, pan, zoom) and keys for every setting. Key help goes to
-// `log` (the terminal); the mode and the frame time go to the window title.
+// `log` (the terminal); the mode, the view, the light and the frame time go to the window
+// title; the S key writes the frame to a PNG.
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -17,6 +19,9 @@ struct WindowOptions {
   double fov_deg = 50;     // Horizontal field of view of the orbit camera.
   double azimuth_deg = 30; // Initial orbit (DefaultOrbit).
   std::optional<double> elevation_deg;  // Default: the source cameras' elevation, else 30.
+  double light_azimuth_deg = 45;    // The light's start (LightDirectionFromAngles); the arrows
+  double light_elevation_deg = 50;  // move it from there.
+  std::filesystem::path screenshot_dir = ".";  // Where the S key writes view-<n>.png.
   void Check() const;      // Throws std::invalid_argument naming the field.
 };
 
