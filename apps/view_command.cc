@@ -111,6 +111,11 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
     std::printf("frame time with the light moving: median %.1f ms, min %.1f ms\n",
                 *times.moving_median_ms, *times.moving_min_ms);
   }
+  std::printf("frame time as the window draws while moving (half resolution%s): camera moving: median %.1f ms",
+              times.moving_light_reduced_ms ? ", half the shadow map's side while the light moves" : "",
+              times.moving_camera_ms);
+  if (times.moving_light_reduced_ms) std::printf(", light moving: median %.1f ms", *times.moving_light_reduced_ms);
+  std::printf("\n");
 }
 
 }  // namespace

@@ -67,6 +67,22 @@ const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int heigh
   return too_fine && !scene.display_mesh.triangles.empty() ? scene.display_mesh : scene.mesh;
 }
 
+ViewCamera MovingView(const ViewCamera& view) {
+  const uint64_t width = std::max<uint64_t>(1, view.camera.width / 2), height = std::max<uint64_t>(1, view.camera.height / 2);
+  const double sx = static_cast<double>(width) / static_cast<double>(view.camera.width);
+  const double sy = static_cast<double>(height) / static_cast<double>(view.camera.height);
+  ViewCamera moving = view;
+  moving.camera = MakePinholeCamera(view.camera.id, width, height, view.camera.FocalX() * sx, view.camera.FocalY() * sy,
+                                    view.camera.PrincipalX() * sx, view.camera.PrincipalY() * sy);
+  return moving;
+}
+
+FrameSettings MovingSettings(const FrameSettings& settings, bool light_moving) {
+  FrameSettings moving = settings;
+  if (light_moving) moving.shadow_map_size = std::max(512, settings.shadow_map_size / 2);
+  return moving;
+}
+
 ShadowChoice ChooseShadows(const ViewerScene& scene, TextureMode texture) {
   // On a real facade's 32k-triangle display mesh a third of the edges are silhouettes, and
   // the volume cost three PCF frames; up to this many triangles it costs about one.
@@ -598,7 +614,8 @@ Eigen::Matrix4f SceneRenderer::Impl::EyeProjection(const ViewCamera& view) const
   return projection;
 }
 
-void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer) {
+void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer,
+                         int window_width, int window_height) {
   settings.Check();
   Impl& r = *impl_;
   const bool reverse_z = r.reverse_z && settings.reverse_z;
@@ -658,7 +675,10 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r.eye.framebuffer.Get());
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, static_cast<GLuint>(window_framebuffer));
-    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    const int shown_width = window_width > 0 ? window_width : width;
+    const int shown_height = window_height > 0 ? window_height : height;
+    glBlitFramebuffer(0, 0, width, height, 0, 0, shown_width, shown_height, GL_COLOR_BUFFER_BIT,
+                      shown_width == width && shown_height == height ? GL_NEAREST : GL_LINEAR);
   }
   CheckGlError("SceneRenderer::Draw");
 }

@@ -90,11 +90,13 @@ class SceneRenderer {
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   // Draws one frame of the view's camera size into the internal framebuffer and, when
-  // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer). The
+  // `window_framebuffer` >= 0, blits it there (0 is a window's default framebuffer), scaled to
+  // `window_width` x `window_height` when given (a frame drawn smaller while moving). The
   // shadow map is re-rendered only when the light, its size or the PCF bias changed (the scene
   // is fixed): moving the eye costs the main pass alone. Only Render fills the auxiliary
   // target; Draw leaves it as it was.
-  void Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer = -1);
+  void Draw(const ViewCamera& view, const FrameSettings& settings, int window_framebuffer = -1,
+            int window_width = 0, int window_height = 0);
 
   // Draws and reads the frame back.
   FrameResult Render(const ViewCamera& view, const FrameSettings& settings);
@@ -119,6 +121,13 @@ class SceneRenderer {
 // if scene.mesh would give a triangle fewer than 16 pixels, else scene.mesh. Finer triangles
 // cost llvmpipe vertex and setup work without adding detail the atlas does not already show.
 const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int height);
+
+// While the user moves the camera or the light, frames give up detail for speed and the first
+// still frame brings it back: half the resolution (a quarter of the pixels, scaled up when
+// shown), and while the light moves a shadow map of half the side (at least 512 texels), which
+// is rendered again every frame.
+ViewCamera MovingView(const ViewCamera& view);
+FrameSettings MovingSettings(const FrameSettings& settings, bool light_moving);
 
 // What `--shadows auto` draws for a scene, and why: nothing when the photos are projected as
 // captured (they hold their own shadows), a shadow map for a point cloud, shadow volumes (exact)

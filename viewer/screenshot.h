@@ -22,12 +22,16 @@ struct ScreenshotOptions {
   int timed_frames = 0;  // More frames drawn after the screenshot to time the renderer.
 };
 
-// The median and the fastest of the timed frames, with a still light and (with a shadow map)
-// with the light moving a little every frame, so that the map is re-rendered each time.
+// The median and the fastest of the timed frames, with a still light and (with shadows) with
+// the light moving a little every frame, so that the map is rendered again each time; and the
+// medians of frames as the window draws them while the user moves the camera or the light
+// (MovingView, MovingSettings).
 struct FrameTimes {
   int frames = 0;
   double median_ms = 0, min_ms = 0;
   std::optional<double> moving_median_ms, moving_min_ms;
+  double moving_camera_ms = 0;
+  std::optional<double> moving_light_reduced_ms;
 };
 
 struct Screenshot {

@@ -56,7 +56,12 @@ struct WindowState {
   double last_x = 0, last_y = 0;
   double fov_deg = 50;
   bool screenshot_requested = false;  // The S key: write the next frame to a PNG.
+  // When the user last moved the camera or the light: frames drawn soon after give up detail.
+  std::chrono::steady_clock::time_point camera_moved, light_moved;
 };
+
+// How long after the last input the window keeps drawing with reduced detail.
+constexpr std::chrono::milliseconds kMotionHold(200);
 
 WindowState* State(GLFWwindow* window) {
   return static_cast<WindowState*>(glfwGetWindowUserPointer(window));
@@ -97,10 +102,16 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_L:
       settings.light.type = settings.light.type == LightKind::kPoint ? LightKind::kDirectional : LightKind::kPoint;
       break;
-    case GLFW_KEY_LEFT: s.light_azimuth_deg -= 5; break;
-    case GLFW_KEY_RIGHT: s.light_azimuth_deg += 5; break;
-    case GLFW_KEY_UP: s.light_elevation_deg = std::min(89.9, s.light_elevation_deg + 5); break;
-    case GLFW_KEY_DOWN: s.light_elevation_deg = std::max(0.1, s.light_elevation_deg - 5); break;
+    case GLFW_KEY_LEFT: s.light_azimuth_deg -= 5; s.light_moved = std::chrono::steady_clock::now(); break;
+    case GLFW_KEY_RIGHT: s.light_azimuth_deg += 5; s.light_moved = std::chrono::steady_clock::now(); break;
+    case GLFW_KEY_UP:
+      s.light_elevation_deg = std::min(89.9, s.light_elevation_deg + 5);
+      s.light_moved = std::chrono::steady_clock::now();
+      break;
+    case GLFW_KEY_DOWN:
+      s.light_elevation_deg = std::max(0.1, s.light_elevation_deg - 5);
+      s.light_moved = std::chrono::steady_clock::now();
+      break;
     case GLFW_KEY_EQUAL: settings.exposure_stops += 0.25f; break;
     case GLFW_KEY_MINUS: settings.exposure_stops -= 0.25f; break;
     case GLFW_KEY_RIGHT_BRACKET: settings.pcf_radius = std::min(4, settings.pcf_radius + 1); break;
@@ -137,6 +148,7 @@ void OnCursor(GLFWwindow* window, double x, double y) {
   s.last_y = y;
   if (!s.dragging_orbit && !s.dragging_pan) return;
   s.source.reset();  // Moving the view leaves the source camera.
+  s.camera_moved = std::chrono::steady_clock::now();
   if (s.dragging_orbit) {
     s.azimuth_deg -= 0.3 * dx;
     s.elevation_deg = std::clamp(s.elevation_deg + 0.3 * dy, -89.0, 89.0);
@@ -151,6 +163,7 @@ void OnCursor(GLFWwindow* window, double x, double y) {
 void OnScroll(GLFWwindow* window, double, double dy) {
   WindowState& s = *State(window);
   s.distance *= std::pow(0.9, dy);
+  s.camera_moved = std::chrono::steady_clock::now();
 }
 
 // What the window shows, for the user (and the window test): modes, view, light, frame time.
@@ -259,7 +272,14 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
     glfwGetFramebufferSize(glfw.window, &width, &height);
     if (width > 0 && height > 0) {
       const auto start = std::chrono::steady_clock::now();
-      renderer.Draw(CurrentView(state, width, height), state.settings, 0);
+      const bool light_moving = start - state.light_moved < kMotionHold;
+      const bool moving = light_moving || start - state.camera_moved < kMotionHold;
+      const ViewCamera view = CurrentView(state, width, height);
+      if (moving) {
+        renderer.Draw(MovingView(view), MovingSettings(state.settings, light_moving), 0, width, height);
+      } else {
+        renderer.Draw(view, state.settings, 0);
+      }
       glFinish();  // So the time measures the frame, not the command submission.
       const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       smoothed_ms = smoothed_ms == 0 ? ms : 0.9 * smoothed_ms + 0.1 * ms;
@@ -271,7 +291,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
         log("wrote " + path.string() + "\n");
       }
       for (const std::string& note : renderer.TakeNotes()) log(note + "\n");
-      glfwSetWindowTitle(glfw.window, WindowTitle(state, smoothed_ms).c_str());
+      glfwSetWindowTitle(glfw.window, (WindowTitle(state, smoothed_ms) + (moving ? " | moving: half resolution" : "")).c_str());
       glfwSwapBuffers(glfw.window);
     }
     glfwPollEvents();

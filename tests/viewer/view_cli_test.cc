@@ -192,10 +192,17 @@ TEST(ViewWindow, SyntheticInputDrivesEveryControl) {
   const double azimuth = TitleNumber(title(), "view az ");
   xdo("windowfocus " + window);
   xdo("mousemove --window " + window + " 240 150");
+  bool reduced_while_moving = false;
   for (const std::string step : {"mousedown 1", "mousemove_relative 50 0", "mousemove_relative 50 0", "mouseup 1"}) {
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
     xdo(step);
+    // Frames within 200 ms of a motion are drawn at half resolution, and say so.
+    if (step.rfind("mousemove", 0) == 0) {
+      reduced_while_moving |= WaitFor([&] { return title().find("moving: half resolution") != std::string::npos; }, 0.15);
+    }
   }
+  EXPECT_TRUE(reduced_while_moving) << title();
+  EXPECT_TRUE(WaitFor([&] { return title().find("moving") == std::string::npos; })) << "full detail once still";
   EXPECT_TRUE(WaitFor([&] { return std::abs(TitleNumber(title(), "view az ") - (azimuth - 30)) < 0.6; })) << title();
   const Image turned = screenshot();
   ASSERT_FALSE(turned.Empty());
