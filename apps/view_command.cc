@@ -59,8 +59,8 @@ FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
     const std::vector<double> p = ParseNumbers(a.point_light, 3, "--point-light");
     settings.light.type = LightKind::kPoint;
     settings.light.position = Eigen::Vector3d(p[0], p[1], p[2]);
-    // Irradiance 1 at the scene's centre, like the default directional light.
-    settings.light.intensity = static_cast<float>((settings.light.position - scene.Centre().cast<double>()).squaredNorm());
+    // The irradiance --light-intensity at the scene's centre, like the directional light's.
+    settings.light.intensity *= static_cast<float>((settings.light.position - scene.Centre().cast<double>()).squaredNorm());
   } else {
     const std::vector<double> angles = ParseNumbers(a.light, 2, "--light");
     settings.light.direction = LightDirectionFromAngles(scene.up, angles[0], angles[1]);
@@ -151,6 +151,20 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_option("--light", a->light, "directional light azimuth,elevation in degrees (default 45,50)");
   command->add_option("--point-light", a->point_light, "a point light at x,y,z (world) instead");
   command->add_option("--exposure", a->settings.exposure_stops, "exposure in stops (default 0)");
+  const std::map<std::string, ToneMap> tone_maps{
+      {"clamp", ToneMap::kClamp}, {"reinhard", ToneMap::kReinhard}, {"aces", ToneMap::kAces}};
+  command->add_option("--tone-map", a->settings.tone_map,
+                      "clamp|reinhard|aces: how linear light becomes display values (default clamp: values over 1 "
+                      "clip; reinhard and aces render into a float frame first)")
+      ->transform(CLI::CheckedTransformer(tone_maps, CLI::ignore_case));
+  command->add_option("--white", a->settings.white, "reinhard: the exposed value shown as white (default 4)")
+      ->check(CLI::Range(1.0, 1e6));
+  command->add_flag("--auto-exposure", a->settings.auto_exposure,
+                    "expose each frame for its log-average luminance (mid grey 0.18), tone-mapped; in the window "
+                    "the eye adapts over half a second");
+  command->add_option("--light-intensity", a->settings.light.intensity,
+                      "the light's irradiance, linear (default 1; a point light's at the scene's centre)")
+      ->check(CLI::Range(0.0, 1e6));
   command->add_option("--shadow-map-size", a->settings.shadow_map_size, "shadow map side in texels (default 2048)")
       ->check(CLI::Range(64, 8192));
   command->add_option("--pcf-radius", a->settings.pcf_radius, "PCF kernel radius in texels (default 1)")

@@ -281,6 +281,18 @@ void EyeTarget::Resize(int new_width, int new_height) {
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     throw std::runtime_error("GL: frame buffer incomplete");
   }
+  hdr = MakeTextureOnScratchUnit();
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
+  hdr_framebuffer = MakeGlFramebuffer();
+  glBindFramebuffer(GL_FRAMEBUFFER, hdr_framebuffer.Get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, hdr.Get(), 0);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, aux.Get(), 0);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_stencil.Get());
+  glDrawBuffers(2, buffers);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("GL: float frame buffer incomplete");
+  }
 }
 
 }  // namespace parallax::gpu

@@ -84,10 +84,12 @@ struct DepthTarget {
   void Resize(int new_width, int new_height);
 };
 
-// The frame: sRGB-encoded color (RGBA8), auxiliary float RGBA, float depth + stencil.
+// The frame: sRGB-encoded color (RGBA8), auxiliary float RGBA, float depth + stencil; and the
+// float frame (RGBA16F linear light) that shares the auxiliary target and the depth, for tone
+// mapping into `color`.
 struct EyeTarget {
-  GlFramebuffer framebuffer;
-  GlTexture color, aux;
+  GlFramebuffer framebuffer, hdr_framebuffer;
+  GlTexture color, aux, hdr;
   GlRenderbuffer depth_stencil;
   int width = 0, height = 0;
 

@@ -1,6 +1,7 @@
 #include "viewer/renderer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -54,6 +55,9 @@ void FrameSettings::Check() const {
                 projective_views, "[1, " + std::to_string(kMaxProjectors) + "]");
   RequireOption(point_size_px > 0, "FrameSettings.point_size_px", point_size_px, "> 0");
   RequireOption(std::isfinite(exposure_stops), "FrameSettings.exposure_stops", exposure_stops, "finite");
+  RequireOption(white >= 1 && std::isfinite(white), "FrameSettings.white", white, ">= 1 and finite");
+  RequireOption(adaptation_seconds >= 0 && std::isfinite(adaptation_seconds), "FrameSettings.adaptation_seconds",
+                adaptation_seconds, ">= 0 and finite");
   if (light.type == LightKind::kDirectional) {
     RequireOption(light.direction.norm() > 0 && light.direction.allFinite(), "FrameSettings.light.direction (norm)",
                   light.direction.norm(), "finite and non-zero");
@@ -140,7 +144,8 @@ struct SceneRenderer::Impl {
   const ViewerScene& scene;
   bool reverse_z = false;  // glClipControl is available (and then always set to zero-to-one).
   GlProgram depth, planar, volume, blob, lines;
-  std::map<std::tuple<int, int, int>, GlProgram> surface_programs;  // By (albedo, shadow mode, PCF radius).
+  // By (albedo, shadow mode, PCF radius, float output).
+  std::map<std::tuple<int, int, int, bool>, GlProgram> surface_programs;
   // What this frame's surface programs need besides the settings.
   Eigen::Matrix4f shadow_from_world = Eigen::Matrix4f::Identity();
   Eigen::Matrix4f projector_from_world[kMaxProjectors];
@@ -170,6 +175,13 @@ struct SceneRenderer::Impl {
   bool volume_note_given = false;
   bool blob_note_given = false;
   bool with_aux = false;       // This frame fills the auxiliary target (Render).
+  bool hdr_now = false;        // This frame is drawn into the float frame, then tone-mapped.
+  GlProgram tone_map;
+  GlVertexArray empty_vao;     // The tone-mapping triangle has no vertex buffer.
+  GlTexture meter;             // The float frame shrunk, to read its brightness back.
+  GlFramebuffer meter_framebuffer;
+  std::optional<double> adapted_luminance;  // What the eye is adapted to (auto exposure).
+  std::chrono::steady_clock::time_point last_adaptation;
   bool reverse_z_now = false;  // This frame's depth is reverse-Z (cleared to 0, GL_GREATER).
 
   explicit Impl(const ViewerScene& s) : scene(s) {}
@@ -248,6 +260,10 @@ struct SceneRenderer::Impl {
   // Binds the eye target at `width` x `height` and clears it to the background (depth cleared
   // for reverse_z_now).
   void BeginFrame(int width, int height, const FrameSettings& settings);
+  // The float frame's log-average luminance (of a 64x36 shrunk copy).
+  double LogAverageLuminance();
+  // Exposes and tone-maps the float frame into the 8-bit frame.
+  void ToneMapFrame(const FrameSettings& settings);
   Eigen::Matrix4f EyeProjection(const ViewCamera& view) const;
 };
 
@@ -306,12 +322,13 @@ int SceneRenderer::Impl::SetUpProjectors(const ViewCamera& view, const FrameSett
 
 const GlProgram& SceneRenderer::Impl::SurfaceProgram(int albedo_source, int shadow_mode, int pcf_radius) {
   if (shadow_mode != 3) pcf_radius = 0;
-  auto found = surface_programs.find({albedo_source, shadow_mode, pcf_radius});
+  const std::tuple key{albedo_source, shadow_mode, pcf_radius, hdr_now};
+  auto found = surface_programs.find(key);
   if (found != surface_programs.end()) return found->second;
   const std::string fragment = "#version 330 core\n#define ALBEDO_SOURCE " + std::to_string(albedo_source) +
                                "\n#define SHADOW_MODE " + std::to_string(shadow_mode) +
-                               "\n#define PCF_RADIUS " + std::to_string(pcf_radius) + "\n" +
-                               shaders::kSurfaceFragment;
+                               "\n#define PCF_RADIUS " + std::to_string(pcf_radius) +
+                               "\n#define HDR_OUTPUT " + (hdr_now ? "1" : "0") + "\n" + shaders::kSurfaceFragment;
   GlProgram program("surface", shaders::kSurfaceVertex, fragment.c_str());
   program.Use();
   program.Set("u_atlas", kAtlasUnit);
@@ -320,7 +337,7 @@ const GlProgram& SceneRenderer::Impl::SurfaceProgram(int albedo_source, int shad
     program.Set(("u_photo" + std::to_string(k)).c_str(), kPhotoUnit + k);
     program.Set(("u_projector_depth" + std::to_string(k)).c_str(), kProjectorDepthUnit + k);
   }
-  return surface_programs.emplace(std::tuple{albedo_source, shadow_mode, pcf_radius}, std::move(program)).first->second;
+  return surface_programs.emplace(key, std::move(program)).first->second;
 }
 
 void SceneRenderer::Impl::UseSurfaceProgram(const GlProgram& program, const ViewCamera& view,
@@ -512,6 +529,71 @@ void SceneRenderer::Impl::DrawBlobShadows(const ViewCamera& view, const FrameSet
   glDepthMask(GL_TRUE);
 }
 
+double SceneRenderer::Impl::LogAverageLuminance() {
+  constexpr int kMeterWidth = 64, kMeterHeight = 36;
+  if (meter.Get() == 0) {
+    meter = gpu::MakeTextureOnScratchUnit();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kMeterWidth, kMeterHeight, 0, GL_RGBA, GL_FLOAT, nullptr);
+    gpu::SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
+    meter_framebuffer = MakeGlFramebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, meter_framebuffer.Get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, meter.Get(), 0);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.hdr_framebuffer.Get());
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, meter_framebuffer.Get());
+  glBlitFramebuffer(0, 0, eye.width, eye.height, 0, 0, kMeterWidth, kMeterHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  std::vector<float> texels(static_cast<size_t>(kMeterWidth) * kMeterHeight * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, meter_framebuffer.Get());
+  glReadPixels(0, 0, kMeterWidth, kMeterHeight, GL_RGBA, GL_FLOAT, texels.data());
+  double sum_log = 0;
+  for (size_t i = 0; i < texels.size(); i += 4) {
+    const double luminance = 0.2126 * texels[i] + 0.7152 * texels[i + 1] + 0.0722 * texels[i + 2];
+    sum_log += std::log(std::max(luminance, 0.0) + 1e-4);  // The offset keeps black pixels finite.
+  }
+  return std::exp(sum_log / static_cast<double>(kMeterWidth * kMeterHeight));
+}
+
+// The frame's exposure (with auto exposure, the eye adapting towards the frame's brightness
+// with the settings' time constant), then the named operator into the 8-bit frame.
+void SceneRenderer::Impl::ToneMapFrame(const FrameSettings& settings) {
+  double exposure = std::exp2(settings.exposure_stops);
+  if (settings.auto_exposure) {
+    const double luminance = LogAverageLuminance();
+    const auto now = std::chrono::steady_clock::now();
+    if (!adapted_luminance || settings.adaptation_seconds <= 0) {
+      adapted_luminance = luminance;
+    } else {
+      const double dt = std::chrono::duration<double>(now - last_adaptation).count();
+      *adapted_luminance += (luminance - *adapted_luminance) * (1 - std::exp(-dt / settings.adaptation_seconds));
+    }
+    last_adaptation = now;
+    constexpr double kMiddleGrey = 0.18;
+    exposure *= kMiddleGrey / *adapted_luminance;
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
+  const GLenum color_only = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &color_only);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_STENCIL_TEST);
+  glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
+  glBindTexture(GL_TEXTURE_2D, eye.hdr.Get());
+  glActiveTexture(GL_TEXTURE0);
+  tone_map.Use();
+  tone_map.Set("u_hdr", gpu::kScratchUnit);
+  tone_map.Set("u_exposure", static_cast<float>(exposure));
+  // Auto exposure alone, on an 8-bit frame that would clip, maps as Reinhard does.
+  const ToneMap op = settings.tone_map == ToneMap::kClamp ? ToneMap::kReinhard : settings.tone_map;
+  tone_map.Set("u_operator", op == ToneMap::kReinhard ? 1 : op == ToneMap::kAces ? 2 : 0);
+  tone_map.Set("u_white", settings.white);
+  glBindVertexArray(empty_vao.Get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
+  glDrawBuffers(2, both);
+}
+
 SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
   Impl& r = *impl_;
   r.reverse_z = HasExtension("GL_ARB_clip_control");
@@ -520,6 +602,8 @@ SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<
   r.planar = GlProgram("planar shadow", shaders::kPlanarVertex, shaders::kPlanarFragment);
   r.volume = GlProgram("shadow volume", shaders::kVolumeVertex, shaders::kVolumeFragment);
   r.blob = GlProgram("blob shadow", shaders::kBlobVertex, shaders::kBlobFragment);
+  r.tone_map = GlProgram("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment);
+  r.empty_vao = MakeGlVertexArray();
   r.lines = GlProgram("lines", shaders::kLineVertex, shaders::kLineFragment);
   r.full_mesh = gpu::UploadMesh(scene.mesh, scene.ground);
   r.display_mesh = gpu::UploadMesh(scene.display_mesh, scene.ground);
@@ -579,10 +663,12 @@ int SceneRenderer::Impl::UpdateShadowMap(const FrameSettings& settings) {
 
 void SceneRenderer::Impl::BeginFrame(int width, int height, const FrameSettings& settings) {
   eye.Resize(width, height);
-  glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
+  glBindFramebuffer(GL_FRAMEBUFFER, hdr_now ? eye.hdr_framebuffer.Get() : eye.framebuffer.Get());
   glViewport(0, 0, width, height);
-  const Eigen::Vector3f background(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
-                                   LinearToSrgb(settings.background.z()));
+  const Eigen::Vector3f background =
+      hdr_now ? settings.background
+              : Eigen::Vector3f(LinearToSrgb(settings.background.x()), LinearToSrgb(settings.background.y()),
+                                LinearToSrgb(settings.background.z()));
   const float clear_color[4] = {background.x(), background.y(), background.z(), 1};
   const float clear_aux[4] = {1, 0, 0, 0};
   glClearBufferfv(GL_COLOR, 0, clear_color);
@@ -620,6 +706,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   Impl& r = *impl_;
   const bool reverse_z = r.reverse_z && settings.reverse_z;
   r.reverse_z_now = reverse_z;
+  r.hdr_now = settings.tone_map != ToneMap::kClamp || settings.auto_exposure;
   const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
   r.cpu_mesh = &DisplayedMesh(r.scene, width, height);
   r.mesh = r.cpu_mesh == &r.scene.display_mesh ? &r.display_mesh : &r.full_mesh;
@@ -663,6 +750,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   }
   r.lines.Use();
   r.lines.Set("u_clip_from_world", clip_from_world);
+  r.lines.Set("u_linear_output", r.hdr_now ? 1 : 0);
   if (settings.show_grid) {
     glBindVertexArray(r.grid.vao.Get());
     glDrawArrays(GL_LINES, 0, r.grid.count);
@@ -670,6 +758,7 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   if (settings.show_cameras && r.frusta.count > 0) r.DrawFrusta(CameraCenter(view.cam_from_world));
   glBindVertexArray(0);
   if (!reverse_z && r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+  if (r.hdr_now) r.ToneMapFrame(settings);
 
   if (window_framebuffer >= 0) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, r.eye.framebuffer.Get());

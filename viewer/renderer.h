@@ -37,6 +37,11 @@ enum class TextureMode {
 
 enum class LightKind { kDirectional, kPoint };
 
+// How linear light becomes a display value. kClamp draws straight into the 8-bit frame (values
+// over 1 clip); the others render into a float frame first and map it: extended Reinhard on
+// luminance (1 maps to about 0.5, `white` to 1), or the ACES filmic curve (Narkowicz's fit).
+enum class ToneMap { kClamp, kReinhard, kAces };
+
 struct LightSettings {
   LightKind type = LightKind::kDirectional;
   Eigen::Vector3d direction = Eigen::Vector3d(-0.4, -0.3, -0.87);  // Directional: travel direction (world).
@@ -53,6 +58,13 @@ struct FrameSettings {
   float specular = 0.15f;         // Blinn-Phong specular weight.
   float shininess = 32;           // Blinn-Phong exponent.
   float exposure_stops = 0;       // Linear color is scaled by 2^stops before sRGB encoding.
+  ToneMap tone_map = ToneMap::kClamp;
+  float white = 4;                // Reinhard: the linear value (after exposure) shown as white.
+  // Exposure from the frame: its log-average luminance is brought to 0.18 (mid grey), on top
+  // of exposure_stops; the frame is then tone-mapped (kClamp counts as Reinhard here).
+  bool auto_exposure = false;
+  // Time constant of the eye's adaptation to a new brightness (seconds); 0 adapts at once.
+  float adaptation_seconds = 0;
   int shadow_map_size = 2048;     // Shadow map side in texels, 64..8192.
   int pcf_radius = 1;             // PCF kernel radius in texels (kernel 2r+1 square), 0..4.
   int projective_views = 3;       // Source photos blended in projective mode, 1..3.

@@ -192,7 +192,11 @@ void main() {
     float highlight = n_dot_l > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
     color = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * u_specular * highlight * irradiance;
   }
+#if HDR_OUTPUT
+  o_color = vec4(color, 1.0);
+#else
   o_color = vec4(LinearToSrgb(color * u_exposure), 1.0);
+#endif
   o_aux = vec4(visibility, n_dot_l, v_eye_depth, 1.0);
 }
 )";
@@ -275,6 +279,33 @@ void main() {
 }
 )";
 
+const char* const kToneMapVertex = R"(#version 330 core
+void main() {
+  vec2 corner = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));  // (0,0) (2,0) (0,2)
+  gl_Position = vec4(corner * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+const char* const kToneMapFragment = R"(#version 330 core
+uniform sampler2D u_hdr;
+uniform float u_exposure;
+uniform int u_operator;  // 0 clamp, 1 extended Reinhard on luminance, 2 ACES filmic
+uniform float u_white;
+layout(location = 0) out vec4 o_color;
+void main() {
+  vec3 c = max(texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb * u_exposure, vec3(0.0));
+  if (u_operator == 1) {
+    float luminance = dot(c, vec3(0.2126, 0.7152, 0.0722));
+    float mapped = luminance * (1.0 + luminance / (u_white * u_white)) / (1.0 + luminance);
+    c *= luminance > 0.0 ? mapped / luminance : 0.0;
+  } else if (u_operator == 2) {
+    c = (c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14);
+  }
+  c = clamp(c, 0.0, 1.0);
+  o_color = vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
+}
+)";
+
 const char* const kLineVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 3) in vec3 a_color;  // Linear RGB.
@@ -288,11 +319,13 @@ void main() {
 
 const char* const kLineFragment = R"(#version 330 core
 in vec3 v_color;
+uniform bool u_linear_output;  // Into the float frame.
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_aux;
 void main() {
   vec3 c = clamp(v_color, 0.0, 1.0);
-  o_color = vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
+  o_color = u_linear_output ? vec4(c, 1.0)
+                            : vec4(mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c)), 1.0);
   o_aux = vec4(1.0, 1.0, 0.0, 0.0);  // Not a surface.
 }
 )";

@@ -5,7 +5,8 @@ namespace parallax::shaders {
 // Surfaces (mesh triangles and point sprites): Blinn-Phong in linear light, shadow map or PCF,
 // projective texturing, exposure, sRGB output; a second output carries light visibility,
 // n.l, eye depth and coverage for tests. The fragment shader has no #version line: prefix it
-// with "#version 330 core" and #defines of ALBEDO_SOURCE, SHADOW_MODE and PCF_RADIUS.
+// with "#version 330 core" and #defines of ALBEDO_SOURCE, SHADOW_MODE, PCF_RADIUS and
+// HDR_OUTPUT (1: linear light without exposure, for the float frame).
 extern const char* const kSurfaceVertex;
 extern const char* const kSurfaceFragment;
 
@@ -24,6 +25,11 @@ extern const char* const kVolumeFragment;
 // Blob shadows: a textured quad on the ground per blob, multiplied into the frame.
 extern const char* const kBlobVertex;
 extern const char* const kBlobFragment;
+
+// Tone mapping: the float frame, exposed and mapped, into the 8-bit sRGB frame (a triangle
+// covering the screen, no vertex buffer).
+extern const char* const kToneMapVertex;
+extern const char* const kToneMapFragment;
 
 // Colored lines: camera frusta and the ground grid.
 extern const char* const kLineVertex;

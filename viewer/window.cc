@@ -247,6 +247,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
   WindowState state;
   state.scene = &scene;
   state.settings = settings;
+  if (settings.auto_exposure) state.settings.adaptation_seconds = 0.5f;  // As eyes adapt, not at once.
   state.azimuth_deg = options.azimuth_deg;
   state.fov_deg = options.fov_deg;
   state.home = DefaultOrbit(scene, options.azimuth_deg, options.elevation_deg,

@@ -1,0 +1,151 @@
+// HDR rendering and materials against references computed here: tone-mapped pixels against
+// the operators applied to the analytic radiance of a lit ground, auto exposure against a scene
+// 16 times brighter, the eye's adaptation over time.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "tests/viewer/viewer_test_util.h"
+#include "viewer/view_cameras.h"
+#include "viewer/view_math.h"
+
+namespace parallax {
+namespace {
+using namespace viewer_test;
+
+const Eigen::Vector3d kLight = Eigen::Vector3d(-0.5, -0.3, -0.8).normalized();
+
+double Srgb(double linear) {
+  linear = std::clamp(linear, 0.0, 1.0);
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1 / 2.4) - 0.055;
+}
+
+double Reinhard(double c, double white) { return c * (1 + c / (white * white)) / (1 + c); }
+double Aces(double c) { return (c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14); }
+
+struct PixelErrors {
+  double mean = 0, max = 0;
+  int pixels = 0;
+};
+
+// Over the lit ground the ray tracer sees: the rendered value against `expected(radiance)`,
+// the radiance being the shader's Blinn-Phong (grey albedo, ambient, specular) for that point.
+PixelErrors CompareLitGround(const ViewerScene& scene, const ViewCamera& view, const FrameSettings& settings,
+                             const FrameResult& frame, const std::function<double(double)>& expected) {
+  const std::vector<ReferencePixel> reference = ReferenceShadows(scene.mesh, view, settings.light.direction);
+  const Eigen::Vector3d eye = CameraCenter(view.cam_from_world), to_light = -settings.light.direction.normalized();
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  PixelErrors errors;
+  for (int y = 0; y < frame.color.Height(); ++y) {
+    for (int x = 0; x < frame.color.Width(); ++x) {
+      const ReferencePixel& ref = reference[static_cast<size_t>(y) * frame.color.Width() + x];
+      // Away from the shadows' edges, where a pixel is part shadow.
+      if (!ref.hit || ref.shadowed || std::abs(ref.point.z()) > 1e-3 || frame.aux.At(x, y, 0) < 1.0f) continue;
+      const Eigen::Vector3d half = (to_light + (eye - ref.point).normalized()).normalized();
+      const double irradiance = settings.light.intensity, ambient = settings.ambient, specular = settings.specular,
+                   shininess = settings.shininess;
+      const double radiance = 0.7 * (ambient + up.dot(to_light) * irradiance) +
+                              specular * std::pow(std::max(up.dot(half), 0.0), shininess) * irradiance;
+      const double error = std::abs(static_cast<double>(frame.color.At(x, y, 1)) - expected(radiance));
+      errors.mean += error;
+      errors.max = std::max(errors.max, error);
+      ++errors.pixels;
+    }
+  }
+  errors.mean /= std::max(errors.pixels, 1);
+  return errors;
+}
+
+ViewerScene BoxOnGround() { return SceneFromObjects({Plane(10), Box({0.5, 0.2, 1}, {2, 2, 2}, 20)}); }
+
+// A light six times the usual on the grey ground: clamped, most of it is white; each operator's
+// pixels are that operator applied to the analytic radiance.
+TEST(ViewerHdr, ToneMappedPixelsAreTheOperatorsOfTheAnalyticRadiance) {
+  EnsureGlContext();
+  const ViewerScene scene = BoxOnGround();
+  SceneRenderer renderer(scene);
+  const ViewCamera view = OrbitViewCamera(scene, 200, 35, 320, 240, 50);
+  FrameSettings settings = ShadowSettings(ShadowMode::kPcf, kLight);
+  settings.light.intensity = 6;
+  settings.white = 8;  // Above the brightest radiance in view (5.2): Reinhard reaches white nowhere.
+  const std::vector<std::tuple<ToneMap, const char*, std::function<double(double)>>> operators = {
+      {ToneMap::kClamp, "clamp", [](double c) { return Srgb(c); }},
+      {ToneMap::kReinhard, "reinhard", [&](double c) { return Srgb(Reinhard(c, settings.white)); }},
+      {ToneMap::kAces, "aces", [](double c) { return Srgb(Aces(c)); }}};
+  for (const auto& [tone_map, name, expected] : operators) {
+    settings.tone_map = tone_map;
+    const FrameResult frame = renderer.Render(view, settings);
+    const PixelErrors errors = CompareLitGround(scene, view, settings, frame, expected);
+    int white = 0;
+    for (int y = 0; y < frame.color.Height(); ++y) {
+      for (int x = 0; x < frame.color.Width(); ++x) white += frame.color.At(x, y, 1) >= 1.0f;
+    }
+    std::printf("[ measure ] %s: lit ground %d pixels, error mean %.5f max %.5f; %d white pixels\n", name,
+                errors.pixels, errors.mean, errors.max, white);
+    EXPECT_GT(errors.pixels, 10000) << name;
+    EXPECT_LT(errors.mean, 1.0 / 255) << name;
+    EXPECT_LT(errors.max, 3.0 / 255) << name;
+    if (tone_map == ToneMap::kClamp) {
+      EXPECT_GT(white, errors.pixels / 2) << "a strong light clips";
+    } else {
+      EXPECT_EQ(white, 0) << name << " keeps every lit pixel below white";
+    }
+  }
+}
+
+double MeanAbsoluteDifference(const Image& a, const Image& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.Pixels().size(); ++i) sum += std::abs(static_cast<double>(a.Pixels()[i] - b.Pixels()[i]));
+  return sum / static_cast<double>(a.Pixels().size());
+}
+
+// Auto exposure shows a scene 16 times brighter (light, ambient and background) as it shows
+// the scene itself; the eye adapting over half a second is dazzled first, then adapts.
+TEST(ViewerHdr, AutoExposureAdaptsToTheScenesBrightness) {
+  EnsureGlContext();
+  const ViewerScene scene = BoxOnGround();
+  SceneRenderer renderer(scene);
+  const ViewCamera view = OrbitViewCamera(scene, 200, 35, 320, 240, 50);
+  FrameSettings dim = ShadowSettings(ShadowMode::kPcf, kLight);
+  dim.auto_exposure = true;
+  FrameSettings bright = dim;
+  bright.light.intensity *= 16;
+  bright.ambient *= 16;
+  bright.background *= 16;
+  const Image dim_frame = renderer.Render(view, dim).color;
+  const Image bright_frame = renderer.Render(view, bright).color;
+  const double auto_difference = MeanAbsoluteDifference(dim_frame, bright_frame);
+  FrameSettings fixed_dim = dim, fixed_bright = bright;
+  fixed_dim.auto_exposure = fixed_bright.auto_exposure = false;
+  fixed_dim.tone_map = fixed_bright.tone_map = ToneMap::kReinhard;
+  const double fixed_difference =
+      MeanAbsoluteDifference(renderer.Render(view, fixed_dim).color, renderer.Render(view, fixed_bright).color);
+  std::printf("[ measure ] 16x brighter: mean difference %.5f with auto exposure, %.5f without\n", auto_difference,
+              fixed_difference);
+  EXPECT_LT(auto_difference, 1.0 / 255);
+  EXPECT_GT(fixed_difference, 0.1);
+
+  // Adapted to the dim scene, the eye meets the bright one: at first too bright, then as the
+  // dim frame was within 2/255 after ten time constants.
+  FrameSettings adapting_dim = dim, adapting_bright = bright;
+  adapting_dim.adaptation_seconds = adapting_bright.adaptation_seconds = 0.05f;
+  SceneRenderer eye(scene);
+  eye.Render(view, adapting_dim);
+  const Image dazzled = eye.Render(view, adapting_bright).color;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const Image adapted = eye.Render(view, adapting_bright).color;
+  const double dazzled_difference = MeanAbsoluteDifference(dazzled, dim_frame);
+  const double adapted_difference = MeanAbsoluteDifference(adapted, dim_frame);
+  std::printf("[ measure ] adaptation: %.5f from the adapted picture at first, %.5f after 0.5 s\n",
+              dazzled_difference, adapted_difference);
+  EXPECT_GT(dazzled_difference, 0.05);
+  EXPECT_LT(adapted_difference, 2.0 / 255);
+}
+
+}  // namespace
+}  // namespace parallax
