@@ -145,8 +145,9 @@ void RegisterViewCommand(CLI::App& app) {
       ->transform(CLI::IsMember({"auto", "none", "blob", "planar", "map", "pcf", "volume"}, CLI::ignore_case));
   const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
                                                     {"projective", TextureMode::kProjective},
-                                                    {"shaded", TextureMode::kShaded}};
-  command->add_option("--texture", a->texture, "atlas|projective|shaded (default atlas)")
+                                                    {"shaded", TextureMode::kShaded},
+                                                    {"matcap", TextureMode::kMatcap}};
+  command->add_option("--texture", a->texture, "atlas|projective|shaded|matcap (default atlas; matcap: the atlas with a sphere-map specular)")
       ->transform(CLI::CheckedTransformer(textures, CLI::ignore_case));
   command->add_option("--light", a->light, "directional light azimuth,elevation in degrees (default 45,50)");
   command->add_option("--point-light", a->point_light, "a point light at x,y,z (world) instead");

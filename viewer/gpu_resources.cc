@@ -234,6 +234,16 @@ GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size) {
   return texture;
 }
 
+void UploadFloatTexture(GlTexture& texture, const std::vector<float>& texels, int size, int unit) {
+  glActiveTexture(GL_TEXTURE0 + unit);
+  if (texture.Get() == 0) texture = MakeGlTexture();
+  glBindTexture(GL_TEXTURE_2D, texture.Get());
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, size, size, 0, GL_RED, GL_FLOAT, texels.data());
+  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
+  glActiveTexture(GL_TEXTURE0);
+}
+
 void DepthTarget::Resize(int new_width, int new_height) {
   if (width == new_width && height == new_height && texture.Get() != 0) return;
   width = new_width;

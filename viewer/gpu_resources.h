@@ -13,9 +13,9 @@
 
 namespace parallax::gpu {
 
-// Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7. Textures are
+// Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7, matcap 8. Textures are
 // created on a unit of their own, so making one never disturbs what a sampler is bound to.
-constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5;
+constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5, kMatcapUnit = 8;
 constexpr int kScratchUnit = 15;
 
 // A texture created and bound on the scratch unit.
@@ -74,6 +74,10 @@ GlTexture UploadSrgbTexture(const Image& image);
 
 // A single-channel linear texture of `size` x `size` bytes, bilinear, clamped to its edge.
 GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size);
+
+// A single-channel float texture of `size` x `size` values, bilinear, clamped to its edge, made
+// (or refilled, when `texture` already holds one) on `unit`.
+void UploadFloatTexture(GlTexture& texture, const std::vector<float>& texels, int size, int unit);
 
 // A depth texture for hardware comparison, with an FBO that renders into it.
 struct DepthTarget {

@@ -12,6 +12,7 @@
 
 #include "viewer/blob_shadows.h"
 #include "viewer/gl.h"
+#include "viewer/matcap.h"
 #include "viewer/gpu_resources.h"
 #include "viewer/overlays.h"
 #include "viewer/shaders.h"
@@ -162,6 +163,9 @@ struct SceneRenderer::Impl {
   Drawable blob_quads;       // Two triangles a blob, placed for `blob_light`.
   std::optional<Eigen::Vector4d> blob_light;
   GlTexture blob_texture;
+  GlTexture matcap;  // For `matcap_key`: the light in camera coordinates, specular, shininess.
+  std::optional<Eigen::Vector4f> matcap_key;
+  void UpdateMatcap(const ViewCamera& view, const FrameSettings& settings);
   Drawable points, frusta, grid;
   double frustum_depth = 0;  // Scene units.
   std::vector<Eigen::Vector3d> source_centres;
@@ -333,6 +337,7 @@ const GlProgram& SceneRenderer::Impl::SurfaceProgram(int albedo_source, int shad
   program.Use();
   program.Set("u_atlas", kAtlasUnit);
   program.Set("u_shadow_map", kShadowUnit);
+  program.Set("u_matcap", gpu::kMatcapUnit);
   for (int k = 0; k < kMaxProjectors; ++k) {
     program.Set(("u_photo" + std::to_string(k)).c_str(), kPhotoUnit + k);
     program.Set(("u_projector_depth" + std::to_string(k)).c_str(), kProjectorDepthUnit + k);
@@ -374,7 +379,9 @@ void SceneRenderer::Impl::DrawSurfaces(const ViewCamera& view, const FrameSettin
                                   int projectors) {
   const int albedo = settings.texture == TextureMode::kProjective ? 1
                      : settings.texture == TextureMode::kShaded ? 2
+                     : settings.texture == TextureMode::kMatcap ? 4
                                                                : 0;
+  if (albedo == 4) UpdateMatcap(view, settings);
   if (settings.show_mesh && mesh->triangles > 0) {
     // Depth pre-pass: the mesh's depth alone first, then the shaded pass where it matches, so
     // each pixel is shaded once however much the walls and pillars overlap (fragment work
@@ -592,6 +599,22 @@ void SceneRenderer::Impl::ToneMapFrame(const FrameSettings& settings) {
   glEnable(GL_DEPTH_TEST);
   const GLenum both[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
   glDrawBuffers(2, both);
+}
+
+// The sphere map for this frame's light as the camera sees it (a point light from the scene's
+// centre), made again when the light turns relative to the camera.
+void SceneRenderer::Impl::UpdateMatcap(const ViewCamera& view, const FrameSettings& settings) {
+  const Eigen::Vector4d light = LightVector(settings.light);
+  const Eigen::Vector3d towards =
+      light.w() == 0 ? Eigen::Vector3d(light.head<3>()) : Eigen::Vector3d(light.head<3>() - scene.FocusCentre().cast<double>());
+  const Eigen::Vector3d in_camera = (view.cam_from_world.rotation * towards).normalized();
+  const Eigen::Vector4f key(static_cast<float>(in_camera.x()), static_cast<float>(in_camera.y()),
+                            static_cast<float>(in_camera.z()), settings.specular * 1000 + settings.shininess);
+  if (matcap_key == key) return;
+  constexpr int kMatcapSize = 256;
+  gpu::UploadFloatTexture(matcap, BlinnPhongMatcap(kMatcapSize, in_camera, settings.specular, settings.shininess),
+                          kMatcapSize, gpu::kMatcapUnit);
+  matcap_key = key;
 }
 
 SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {

@@ -33,6 +33,7 @@ enum class TextureMode {
   kAtlas,       // The mesh's texture atlas (points: their colors), lit.
   kProjective,  // Source photos projected from their cameras, shown as captured.
   kShaded,      // Uniform grey albedo, lit: shows the geometry and the shadows.
+  kMatcap,      // The atlas lit, with the specular of a sphere map (viewer/matcap.h).
 };
 
 enum class LightKind { kDirectional, kPoint };

@@ -43,7 +43,10 @@ layout(location = 1) out vec4 o_aux;  // visibility, n.l, eye depth, coverage
 
 // Compile-time constants: one program per combination, so llvmpipe runs no dead branches
 // (a single program with uniform switches ran 6x slower).
-const int u_albedo_source = ALBEDO_SOURCE;  // 0 atlas, 1 projective, 2 constant grey, 3 vertex color
+// 0 atlas, 1 projective, 2 constant grey, 3 vertex color, 4 atlas with the matcap's specular
+const int u_albedo_source = ALBEDO_SOURCE;
+uniform sampler2D u_matcap;   // Specular by the camera-space normal (BlinnPhongMatcap).
+uniform mat4 u_cam_from_world;
 uniform sampler2D u_atlas;
 uniform bool u_has_atlas;
 uniform vec3 u_eye;
@@ -168,7 +171,7 @@ void main() {
 
   vec3 albedo = vec3(0.7);
   bool relight = true;
-  if (u_albedo_source == 0) {
+  if (u_albedo_source == 0 || (u_albedo_source == 4 && u_has_atlas)) {
     albedo = texture(u_atlas, v_uv).rgb;  // An sRGB texture: sampling returns linear values.
   } else if (u_albedo_source == 3) {
     albedo = SrgbToLinear(v_color);
@@ -189,8 +192,13 @@ void main() {
   if (relight) {
     float lit = visibility * max(n_dot_l, 0.0);
     vec3 h = normalize(to_light + view_dir);
-    float highlight = n_dot_l > 0.0 ? pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
-    color = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * u_specular * highlight * irradiance;
+#if ALBEDO_SOURCE == 4
+    vec3 n_camera = mat3(u_cam_from_world) * n;
+    float specular = texture(u_matcap, n_camera.xy * 0.5 + 0.5).r;
+#else
+    float specular = n_dot_l > 0.0 ? u_specular * pow(max(dot(n, h), 0.0), u_shininess) : 0.0;
+#endif
+    color = albedo * (vec3(u_ambient) + lit * irradiance) + visibility * specular * irradiance;
   }
 #if HDR_OUTPUT
   o_color = vec4(color, 1.0);

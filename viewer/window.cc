@@ -38,6 +38,7 @@ const char* TextureName(TextureMode mode) {
     case TextureMode::kAtlas: return "atlas";
     case TextureMode::kProjective: return "projective";
     case TextureMode::kShaded: return "shaded";
+    case TextureMode::kMatcap: return "matcap";
   }
   return "?";
 }
@@ -92,7 +93,7 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_5: settings.shadows = ShadowMode::kVolume; break;
     case GLFW_KEY_6: settings.shadows = ShadowMode::kBlob; break;
     case GLFW_KEY_T:
-      settings.texture = static_cast<TextureMode>((static_cast<int>(settings.texture) + 1) % 3);
+      settings.texture = static_cast<TextureMode>((static_cast<int>(settings.texture) + 1) % 4);
       break;
     case GLFW_KEY_S: s.screenshot_requested = true; break;
     case GLFW_KEY_C: settings.show_cameras = !settings.show_cameras; break;
@@ -225,7 +226,7 @@ void WindowOptions::Check() const {
 std::string ViewerKeyHelp() {
   return "keys: mouse left drag orbit | right/middle drag pan | wheel zoom\n"
          "      1 no shadows  2 planar  3 shadow map  4 PCF  5 volumes  6 blob  [ ] PCF radius\n"
-         "      T texture atlas/projective/shaded   C cameras  P points  M mesh  G grid\n"
+         "      T texture atlas/projective/shaded/matcap   C cameras  P points  M mesh  G grid\n"
          "      arrows move the light  L point/directional light  + - exposure\n"
          "      N / B next / previous source camera   R reset view   S screenshot   Esc quit\n";
 }

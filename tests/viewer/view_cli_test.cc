@@ -182,6 +182,8 @@ TEST(ViewWindow, SyntheticInputDrivesEveryControl) {
   key("t");
   EXPECT_TRUE(title_shows("texture shaded")) << title();
   key("t");
+  EXPECT_TRUE(title_shows("texture matcap")) << title();
+  key("t");
   EXPECT_TRUE(title_shows("texture atlas")) << title();
   key("Right");
   EXPECT_TRUE(title_shows("light az 50")) << title();
