@@ -67,7 +67,9 @@ BlobCasters FindBlobCasters(const TriangleMesh& mesh, const GroundPlane& ground,
   std::vector<bool> above(mesh.vertices.size(), false);
   for (const Eigen::Vector3i& t : mesh.triangles) {
     bool standing = false;
-    for (int c = 0; c < 3; ++c) standing |= ground.SignedDistance(mesh.vertices[t[c]].cast<double>()) > tolerance;
+    for (int c = 0; c < 3; ++c) {
+      standing |= ground.SignedDistance(mesh.vertices[t[c]].cast<double>()) > static_cast<double>(tolerance);
+    }
     if (!standing) continue;
     for (int c = 0; c < 3; ++c) above[t[c]] = true;
     parent[Root(parent, t[1])] = Root(parent, t[0]);

@@ -555,7 +555,8 @@ double SceneRenderer::Impl::LogAverageLuminance() {
   glReadPixels(0, 0, kMeterWidth, kMeterHeight, GL_RGBA, GL_FLOAT, texels.data());
   double sum_log = 0;
   for (size_t i = 0; i < texels.size(); i += 4) {
-    const double luminance = 0.2126 * texels[i] + 0.7152 * texels[i + 1] + 0.0722 * texels[i + 2];
+    const double luminance = 0.2126 * static_cast<double>(texels[i]) + 0.7152 * static_cast<double>(texels[i + 1]) +
+                             0.0722 * static_cast<double>(texels[i + 2]);
     sum_log += std::log(std::max(luminance, 0.0) + 1e-4);  // The offset keeps black pixels finite.
   }
   return std::exp(sum_log / static_cast<double>(kMeterWidth * kMeterHeight));
@@ -572,7 +573,7 @@ void SceneRenderer::Impl::ToneMapFrame(const FrameSettings& settings) {
       adapted_luminance = luminance;
     } else {
       const double dt = std::chrono::duration<double>(now - last_adaptation).count();
-      *adapted_luminance += (luminance - *adapted_luminance) * (1 - std::exp(-dt / settings.adaptation_seconds));
+      *adapted_luminance += (luminance - *adapted_luminance) * (1 - std::exp(-dt / static_cast<double>(settings.adaptation_seconds)));
     }
     last_adaptation = now;
     constexpr double kMiddleGrey = 0.18;
@@ -623,7 +624,7 @@ SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<
   if (r.reverse_z) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   r.depth = GlProgram("depth", shaders::kDepthVertex, shaders::kDepthFragment);
   r.planar = GlProgram("planar shadow", shaders::kPlanarVertex, shaders::kPlanarFragment);
-  r.volume = GlProgram("shadow volume", shaders::kVolumeVertex, shaders::kVolumeFragment);
+  r.volume = GlProgram("shadow volume", shaders::kVolumeVertex, shaders::kDepthFragment);
   r.blob = GlProgram("blob shadow", shaders::kBlobVertex, shaders::kBlobFragment);
   r.tone_map = GlProgram("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment);
   r.empty_vao = MakeGlVertexArray();

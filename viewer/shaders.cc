@@ -257,10 +257,6 @@ uniform mat4 u_clip_from_world;
 void main() { gl_Position = u_clip_from_world * a_position; }
 )";
 
-const char* const kVolumeFragment = R"(#version 330 core
-void main() {}
-)";
-
 const char* const kBlobVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 2) in vec2 a_uv;  // Across the blob: [-1, 1]^2.

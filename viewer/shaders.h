@@ -10,7 +10,7 @@ namespace parallax::shaders {
 extern const char* const kSurfaceVertex;
 extern const char* const kSurfaceFragment;
 
-// Depth only, from a light or a projector.
+// Depth only, from a light or a projector; the fragment shader also serves the shadow volumes.
 extern const char* const kDepthVertex;
 extern const char* const kDepthFragment;
 
@@ -18,9 +18,9 @@ extern const char* const kDepthFragment;
 extern const char* const kPlanarVertex;
 extern const char* const kPlanarFragment;
 
-// Shadow volumes: homogeneous world points (w = 0 at infinity), counted in the stencil only.
+// Shadow volumes: homogeneous world points (w = 0 at infinity), counted in the stencil only
+// (with kDepthFragment).
 extern const char* const kVolumeVertex;
-extern const char* const kVolumeFragment;
 
 // Blob shadows: a textured quad on the ground per blob, multiplied into the frame.
 extern const char* const kBlobVertex;

@@ -64,8 +64,6 @@ PixelErrors CompareLitGround(const ViewerScene& scene, const ViewCamera& view, c
   return errors;
 }
 
-ViewerScene BoxOnGround() { return SceneFromObjects({Plane(10), Box({0.5, 0.2, 1}, {2, 2, 2}, 20)}); }
-
 // A light six times the usual on the grey ground: clamped, most of it is white; each operator's
 // pixels are that operator applied to the analytic radiance.
 TEST(ViewerHdr, ToneMappedPixelsAreTheOperatorsOfTheAnalyticRadiance) {
@@ -156,11 +154,7 @@ TEST(ViewerHdr, AutoExposureAdaptsToTheScenesBrightness) {
 // light and the eye.
 TEST(ViewerMatcap, SphereMapSpecularMatchesBlinnPhong) {
   EnsureGlContext();
-  ObjectDesc sphere;
-  sphere.type = ShapeType::kSphere;
-  sphere.material = "m";
-  sphere.radius = 1;
-  const ViewerScene scene = SceneFromObjects({sphere});
+  const ViewerScene scene = SceneFromObjects({Sphere(1)});
   SceneRenderer renderer(scene);
   ViewCamera view;
   view.camera = ViewerCamera(320, 320, 2.5);

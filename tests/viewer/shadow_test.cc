@@ -25,10 +25,6 @@ void MaybeSave(const std::string& name, const FrameResult& result) {
 
 const Eigen::Vector3d kLight = Eigen::Vector3d(-0.5, -0.3, -0.8).normalized();
 
-ViewerScene BoxOnGround() {
-  return SceneFromObjects({Plane(10), Box({0.5, 0.2, 1}, {2, 2, 2}, 20)});
-}
-
 ViewCamera TestView(const ViewerScene& scene) {
   ViewCamera view = OrbitViewCamera(scene, 200, 35, 640, 480, 50);
   return view;
@@ -177,11 +173,7 @@ TEST(ViewerShadows, PlanarShadowsAreSkippedWithANoteWithoutAGround) {
   EnsureGlContext();
   // A lone box: no plane holds 15% of its surface samples within tolerance... except a face;
   // a sphere has no plane at all.
-  ObjectDesc sphere;
-  sphere.type = ShapeType::kSphere;
-  sphere.material = "m";
-  sphere.radius = 1;
-  const ViewerScene scene = SceneFromObjects({sphere});
+  const ViewerScene scene = SceneFromObjects({Sphere(1)});
   EXPECT_FALSE(scene.ground.has_value());
   SceneRenderer renderer(scene);
   renderer.Render(TestView(scene), ShadowSettings(ShadowMode::kPlanar, kLight));

@@ -119,13 +119,13 @@ double TitleNumber(const std::string& title, const std::string& key) {
 
 double MeanValue(const Image& image) {
   double sum = 0;
-  for (float v : image.Pixels()) sum += v;
+  for (float v : image.Pixels()) sum += static_cast<double>(v);
   return sum / static_cast<double>(image.Pixels().size());
 }
 
 double MeanAbsoluteDifference(const Image& a, const Image& b) {
   double sum = 0;
-  for (size_t i = 0; i < a.Pixels().size(); ++i) sum += std::abs(a.Pixels()[i] - b.Pixels()[i]);
+  for (size_t i = 0; i < a.Pixels().size(); ++i) sum += std::abs(static_cast<double>(a.Pixels()[i] - b.Pixels()[i]));
   return sum / static_cast<double>(a.Pixels().size());
 }
 

@@ -42,6 +42,14 @@ inline ObjectDesc Box(const Eigen::Vector3d& center, const Eigen::Vector3d& size
   return box;
 }
 
+inline ObjectDesc Sphere(double radius) {
+  ObjectDesc sphere;
+  sphere.type = ShapeType::kSphere;
+  sphere.material = "m";
+  sphere.radius = radius;
+  return sphere;
+}
+
 // The objects as one mesh with a grey 2x2 atlas, bounds and ground plane computed.
 inline ViewerScene SceneFromObjects(const std::vector<ObjectDesc>& objects) {
   ViewerScene scene;
@@ -58,6 +66,11 @@ inline ViewerScene SceneFromObjects(const std::vector<ObjectDesc>& objects) {
   for (float& v : scene.mesh.atlas.Pixels()) v = 0.7f;
   FinishViewerScene(scene);
   return scene;
+}
+
+// A 2 m box turned 20 degrees on a 10 m ground: the shadow tests' scene.
+inline ViewerScene BoxOnGround() {
+  return SceneFromObjects({Plane(10), Box({0.5, 0.2, 1}, {2, 2, 2}, 20)});
 }
 
 // SceneRenderer settings for shadow measurements: grey albedo, nothing but the mesh.
