@@ -84,7 +84,10 @@ ViewCamera MovingView(const ViewCamera& view) {
 
 FrameSettings MovingSettings(const FrameSettings& settings, bool light_moving) {
   FrameSettings moving = settings;
-  if (light_moving) moving.shadow_map_size = std::max(512, settings.shadow_map_size / 2);
+  if (light_moving) {
+    moving.shadow_map_size = std::max(512, settings.shadow_map_size / 2);
+    moving.pcf_radius = 0;
+  }
   return moving;
 }
 
@@ -157,6 +160,7 @@ struct SceneRenderer::Impl {
   GpuMesh full_mesh, display_mesh;  // display_mesh is empty without a simplified copy.
   const GpuMesh* mesh = &full_mesh;  // This frame's level of detail (shadows and eye alike).
   const TriangleMesh* cpu_mesh = nullptr;  // The same level of detail on the CPU.
+  std::vector<Eigen::Vector3f> cloud_positions;  // The fused cloud's points.
   gpu::HomogeneousTriangles shadow_volume;
   std::optional<ShadowVolumeKey> shadow_volume_key;  // Absent until the volume is built.
   BlobCasters blob_casters;  // The objects on the ground (of the full mesh), when there is one.
@@ -199,11 +203,12 @@ struct SceneRenderer::Impl {
     return {towards.x(), towards.y(), towards.z(), 0};
   }
   Eigen::Matrix4f LightMatrix(const LightSettings& light) const {
-    // The map covers the robust extent (its resolution is not spent on outliers); its depth
-    // range holds everything, so no caster is clipped away.
-    return light.type == LightKind::kPoint
-               ? PointLightMatrix(light.position, scene.extent, scene.bounds, Range())
-               : DirectionalLightMatrix(light.direction, scene.extent, scene.bounds, Range());
+    // A directional light's map covers what it sees of the geometry drawn but its outermost
+    // half percent (its resolution is not spent on outliers), a point light's the robust
+    // extent; the depth range holds everything, so no caster is clipped away.
+    if (light.type == LightKind::kPoint) return PointLightMatrix(light.position, scene.extent, scene.bounds, Range());
+    return DirectionalLightMatrix(light.direction, mesh->triangles > 0 ? cpu_mesh->vertices : cloud_positions,
+                                  scene.bounds, Range());
   }
   // What casts shadows and occludes projectors: the mesh when there is one, else the points.
   void DrawCasters(const FrameSettings& settings, const GlProgram& program) {
@@ -632,6 +637,7 @@ SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<
   r.full_mesh = gpu::UploadMesh(scene.mesh, scene.ground);
   r.display_mesh = gpu::UploadMesh(scene.display_mesh, scene.ground);
   if (!scene.points.empty()) r.points = Upload(PointVertices(scene.points));
+  for (const ColoredPoint& point : scene.points) r.cloud_positions.push_back(point.position);
   r.frustum_depth = FrustumDepth(scene);
   for (const ViewerSource& source : scene.sources) r.source_centres.push_back(CameraCenter(source.cam_from_world));
   if (!scene.sources.empty()) r.frusta = Upload(FrustumLines(scene.sources, r.frustum_depth));

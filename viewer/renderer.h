@@ -138,7 +138,7 @@ const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int heigh
 // While the user moves the camera or the light, frames give up detail for speed and the first
 // still frame brings it back: half the resolution (a quarter of the pixels, scaled up when
 // shown), and while the light moves a shadow map of half the side (at least 512 texels), which
-// is rendered again every frame.
+// is rendered again every frame, read without PCF's filter.
 ViewCamera MovingView(const ViewCamera& view);
 FrameSettings MovingSettings(const FrameSettings& settings, bool light_moving);
 

@@ -165,7 +165,7 @@ void main() {
     visibility = 0.0;
   } else if (u_shadow_mode == 4) {
     visibility = 0.0;  // Second pass of shadow volumes: the stencil passes shadowed pixels alone.
-  } else if ((u_shadow_mode == 2 || u_shadow_mode == 3) && n_dot_l > 0.0) {
+  } else if (u_shadow_mode == 2 || u_shadow_mode == 3) {
     visibility = ShadowVisibility();
   }
 

@@ -96,22 +96,47 @@ Eigen::Vector2d DepthBounds(const Eigen::AlignedBox3f& box, const Rigid3d& cam_f
   return {near, far};
 }
 
-Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const Eigen::AlignedBox3f& box,
-                                       const Eigen::AlignedBox3f& depth_box, DepthRange range) {
-  const Eigen::Vector3d centre = box.center().cast<double>();
-  const double radius = std::max(1e-9, 0.5 * static_cast<double>(box.diagonal().norm()));
+Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const std::vector<Eigen::Vector3f>& points,
+                                       const Eigen::AlignedBox3f& depth_box, DepthRange range, double outlier_share) {
+  Eigen::AlignedBox3f all = depth_box;
+  for (const Eigen::Vector3f& p : points) all.extend(p);
+  if (all.isEmpty()) all.extend(Eigen::Vector3f::Zero());
+  const Eigen::Vector3d centre = all.center().cast<double>();
+  const double radius = std::max(1e-9, 0.5 * static_cast<double>(all.diagonal().norm()));
   const Rigid3d light_from_world = LookAlong(centre - 2 * radius * direction.normalized(), direction);
+  std::vector<double> across[2];
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
+  for (const Eigen::Vector3f& point : points) {
+    const Eigen::Vector3d p = light_from_world * point.cast<double>();
+    across[0].push_back(p.x());
+    across[1].push_back(p.y());
+    lo.z() = std::min(lo.z(), p.z());
+    hi.z() = std::max(hi.z(), p.z());
+  }
+  for (int axis = 0; axis < 2; ++axis) {
+    std::vector<double>& values = across[axis];
+    if (values.empty()) continue;
+    const size_t cut = static_cast<size_t>(outlier_share * static_cast<double>(values.size()));
+    std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(cut), values.end());
+    lo[axis] = values[cut];
+    std::nth_element(values.begin(), values.end() - 1 - static_cast<std::ptrdiff_t>(cut), values.end());
+    hi[axis] = values[values.size() - 1 - cut];
+  }
   for (int corner = 0; corner < 8; ++corner) {
+    if (depth_box.isEmpty()) break;
     const auto type = static_cast<Eigen::AlignedBox3f::CornerType>(corner);
-    const Eigen::Vector3d p = light_from_world * box.corner(type).cast<double>();
-    lo = lo.cwiseMin(p);
-    hi = hi.cwiseMax(p);
-    if (depth_box.isEmpty()) continue;
-    const double z = (light_from_world * depth_box.corner(type).cast<double>()).z();
-    lo.z() = std::min(lo.z(), z);
-    hi.z() = std::max(hi.z(), z);
+    const Eigen::Vector3d p = light_from_world * depth_box.corner(type).cast<double>();
+    if (across[0].empty()) {  // No points: the box across the light too.
+      lo.head<2>() = lo.head<2>().cwiseMin(p.head<2>());
+      hi.head<2>() = hi.head<2>().cwiseMax(p.head<2>());
+    }
+    lo.z() = std::min(lo.z(), p.z());
+    hi.z() = std::max(hi.z(), p.z());
+  }
+  if (!(lo.array() < hi.array()).all()) {  // One point, or none: a unit square about it.
+    lo = lo.cwiseMin(hi) - Eigen::Vector3d::Ones();
+    hi = lo + 2 * Eigen::Vector3d::Ones();
   }
   // A sliver of margin so the scene's extreme surfaces are not clipped by the depth range.
   const Eigen::Vector3d margin = 1e-3 * radius * Eigen::Vector3d::Ones();

@@ -6,6 +6,8 @@
 // (x right, y down, z forward); the projections below map that frame to clip space with NDC y
 // up, so pixel (u, v) of the camera (v downward, centres at +0.5) lands on the same pixel of a
 // framebuffer read back top row first.
+#include <vector>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -39,11 +41,13 @@ Eigen::Matrix4f OrthographicProjection(const Eigen::Vector3d& min, const Eigen::
 Eigen::Vector2d DepthBounds(const Eigen::AlignedBox3f& box, const Rigid3d& cam_from_world);
 
 // light_clip_from_world of a directional light travelling along `direction`: orthographic,
-// tightly bounding the box's eight corners across the light; along it, the depth range also
-// holds `depth_box` (e.g. the exact bounds, when `box` leaves out outliers: casters outside
-// `box` must not be clipped away from the map).
-Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const Eigen::AlignedBox3f& box,
-                                       const Eigen::AlignedBox3f& depth_box, DepthRange range);
+// across the light bounding `points` but the `outlier_share` farthest out on each side of each
+// axis (as the light sees them: an axis-aligned box of a tilted scene would waste the map's
+// texels); along it, the depth range holds the points and `depth_box` (e.g. the exact bounds:
+// casters must not be clipped away from the map).
+Eigen::Matrix4f DirectionalLightMatrix(const Eigen::Vector3d& direction, const std::vector<Eigen::Vector3f>& points,
+                                       const Eigen::AlignedBox3f& depth_box, DepthRange range,
+                                       double outlier_share = 0.005);
 
 // light_clip_from_world of a point light at `position` looking at the box: a square
 // perspective frustum that contains the box's corners, near/far fitted to the corners of the
