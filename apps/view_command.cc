@@ -85,9 +85,8 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
                 scene.mesh.triangles.size());
   }
   if (a.shadow_iou) {
-    // The ground band of planar and blob shadows: 1% of the focus radius.
     const ShadowAccuracy accuracy = MeasureShadowAccuracy(*shot.drawn, shot.view, settings, shot.frame, scene.ground,
-                                                          0.01 * static_cast<double>(scene.FocusRadius()));
+                                                          static_cast<double>(GroundBand(scene)));
     const MaskComparison& mask = accuracy.all;
     const MaskComparison& cast = accuracy.cast;
     std::printf("shadow IoU against Embree ray tracing: %.4f (%d rendered, %d ray-traced shadowed of %d pixels); "

@@ -113,8 +113,8 @@ std::vector<Blob> PlaceBlobs(const TriangleMesh& mesh, const BlobCasters& caster
   return blobs;
 }
 
-std::vector<uint8_t> BlobTexture(int size) {
-  std::vector<uint8_t> texels(static_cast<size_t>(size) * static_cast<size_t>(size));
+std::vector<float> BlobTexture(int size) {
+  std::vector<float> texels(static_cast<size_t>(size) * static_cast<size_t>(size));
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
       const double s = 2 * (x + 0.5) / size - 1, t = 2 * (y + 0.5) / size - 1;
@@ -124,7 +124,7 @@ std::vector<uint8_t> BlobTexture(int size) {
       constexpr double kCore = 0.35;
       const double visibility = kCore + (1 - kCore) * r * r * (3 - 2 * r);
       texels[static_cast<size_t>(y) * static_cast<size_t>(size) + static_cast<size_t>(x)] =
-          static_cast<uint8_t>(std::lround(255 * visibility));
+          static_cast<float>(visibility);
     }
   }
   return texels;

@@ -4,7 +4,6 @@
 // viewer's shadows: no shadow on other objects or on the object itself, the shape only roughly
 // the object's. The ellipse is where the object's vertices fall when pushed along the light
 // onto the ground (their mean and spread), so the blob moves with the light as a shadow does.
-#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,6 +43,6 @@ std::vector<Blob> PlaceBlobs(const TriangleMesh& mesh, const BlobCasters& caster
 // inscribed circle), row by row: dark to two thirds of the radius, then a smooth rim. It is
 // multiplied into the frame, so the core keeps about the share of the color a real shadow
 // keeps in ambient light.
-std::vector<uint8_t> BlobTexture(int size);
+std::vector<float> BlobTexture(int size);
 
 }  // namespace parallax

@@ -226,14 +226,6 @@ GlTexture UploadSrgbTexture(const Image& image) {
   return texture;
 }
 
-GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size) {
-  GlTexture texture = MakeTextureOnScratchUnit();
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, size, size, 0, GL_RED, GL_UNSIGNED_BYTE, texels.data());
-  SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
-  return texture;
-}
-
 void UploadFloatTexture(GlTexture& texture, const std::vector<float>& texels, int size, int unit) {
   glActiveTexture(GL_TEXTURE0 + unit);
   if (texture.Get() == 0) texture = MakeGlTexture();

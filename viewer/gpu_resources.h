@@ -72,9 +72,6 @@ void SetTextureParameters(GLenum filter, GLenum wrap);
 // linear values.
 GlTexture UploadSrgbTexture(const Image& image);
 
-// A single-channel linear texture of `size` x `size` bytes, bilinear, clamped to its edge.
-GlTexture UploadGreyTexture(const std::vector<uint8_t>& texels, int size);
-
 // A single-channel float texture of `size` x `size` values, bilinear, clamped to its edge, made
 // (or refilled, when `texture` already holds one) on `unit`.
 void UploadFloatTexture(GlTexture& texture, const std::vector<float>& texels, int size, int unit);

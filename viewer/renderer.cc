@@ -66,6 +66,8 @@ void FrameSettings::Check() const {
   RequireOption(light.position.allFinite(), "FrameSettings.light.position (norm)", light.position.norm(), "finite");
 }
 
+float GroundBand(const ViewerScene& scene) { return 0.01f * scene.FocusRadius(); }
+
 const TriangleMesh& DisplayedMesh(const ViewerScene& scene, int width, int height) {
   constexpr size_t kPixelsPerTriangle = 16;
   const bool too_fine = scene.mesh.triangles.size() * kPixelsPerTriangle > static_cast<size_t>(width) * static_cast<size_t>(height);
@@ -168,7 +170,7 @@ struct SceneRenderer::Impl {
   std::optional<Eigen::Vector4d> blob_light;
   GlTexture blob_texture;
   GlTexture matcap;  // For `matcap_key`: the light in camera coordinates, specular, shininess.
-  std::optional<Eigen::Vector4f> matcap_key;
+  std::optional<std::tuple<Eigen::Vector3d, float, float>> matcap_key;
   void UpdateMatcap(const ViewCamera& view, const FrameSettings& settings);
   Drawable points, frusta, grid;
   double frustum_depth = 0;  // Scene units.
@@ -179,9 +181,13 @@ struct SceneRenderer::Impl {
   std::map<int, GlTexture> photos;  // By source index, loaded on first use.
   EyeTarget eye;
   std::vector<std::string> notes;
-  bool planar_note_given = false;
-  bool volume_note_given = false;
-  bool blob_note_given = false;
+  // Tells the user `note` the first time only (a skipped shadow method is skipped every frame).
+  void NoteOnce(const std::string& note) {
+    if (std::find(notes_given.begin(), notes_given.end(), note) != notes_given.end()) return;
+    notes_given.push_back(note);
+    notes.push_back(note);
+  }
+  std::vector<std::string> notes_given;
   bool with_aux = false;       // This frame fills the auxiliary target (Render).
   bool hdr_now = false;        // This frame is drawn into the float frame, then tone-mapped.
   GlProgram tone_map;
@@ -259,7 +265,7 @@ struct SceneRenderer::Impl {
   void DrawBlobShadows(const ViewCamera& view, const FrameSettings& settings, const Eigen::Matrix4f& clip_from_world);
   // Ground within this distance of the plane receives planar and blob shadows; triangles
   // reaching higher cast them.
-  float GroundTolerance() const { return 0.01f * scene.FocusRadius(); }
+  float GroundTolerance() const { return GroundBand(scene); }
   static Eigen::Vector4f GroundVector(const GroundPlane& ground) {
     return Eigen::Vector4d(ground.normal.x(), ground.normal.y(), ground.normal.z(), ground.offset).cast<float>();
   }
@@ -500,12 +506,11 @@ void SceneRenderer::Impl::DrawVolumeShadows(const ViewCamera& view, const FrameS
 void SceneRenderer::Impl::DrawBlobShadows(const ViewCamera& view, const FrameSettings& settings,
                                      const Eigen::Matrix4f& clip_from_world) {
   if (!scene.ground) {
-    if (!blob_note_given) notes.push_back("blob shadows skipped: no ground plane was found in the scene");
-    blob_note_given = true;
+    NoteOnce("blob shadows skipped: no ground plane was found in the scene");
     return;
   }
   if (blob_texture.Get() == 0) {
-    blob_texture = gpu::UploadGreyTexture(BlobTexture(kBlobTextureSize), kBlobTextureSize);
+    gpu::UploadFloatTexture(blob_texture, BlobTexture(kBlobTextureSize), kBlobTextureSize, gpu::kScratchUnit);
     // Objects are what rises five times the ground band above it (a reconstructed ground's
     // bumps do not join them into one); a footprint wider than a third of the scene is a wall
     // or a building around it.
@@ -614,8 +619,7 @@ void SceneRenderer::Impl::UpdateMatcap(const ViewCamera& view, const FrameSettin
   const Eigen::Vector3d towards =
       light.w() == 0 ? Eigen::Vector3d(light.head<3>()) : Eigen::Vector3d(light.head<3>() - scene.FocusCentre().cast<double>());
   const Eigen::Vector3d in_camera = (view.cam_from_world.rotation * towards).normalized();
-  const Eigen::Vector4f key(static_cast<float>(in_camera.x()), static_cast<float>(in_camera.y()),
-                            static_cast<float>(in_camera.z()), settings.specular * 1000 + settings.shininess);
+  const std::tuple key{in_camera, settings.specular, settings.shininess};
   if (matcap_key == key) return;
   constexpr int kMatcapSize = 256;
   gpu::UploadFloatTexture(matcap, BlinnPhongMatcap(kMatcapSize, in_camera, settings.specular, settings.shininess),
@@ -664,7 +668,9 @@ size_t SceneRenderer::ShadowBytes(ShadowMode mode) const {
     case ShadowMode::kPcf: return static_cast<size_t>(r.shadow.width) * static_cast<size_t>(r.shadow.height) * sizeof(float);
     case ShadowMode::kVolume: return static_cast<size_t>(r.shadow_volume.count) * sizeof(Eigen::Vector4f);
     case ShadowMode::kBlob:
-      return r.blob_texture.Get() == 0 ? 0 : kBlobTextureSize * kBlobTextureSize + static_cast<size_t>(r.blob_quads.count) * sizeof(Vertex);
+      return r.blob_texture.Get() == 0 ? 0
+                                       : kBlobTextureSize * kBlobTextureSize * sizeof(float) +
+                                             static_cast<size_t>(r.blob_quads.count) * sizeof(Vertex);
     case ShadowMode::kNone:
     case ShadowMode::kPlanar: return 0;
   }
@@ -764,18 +770,16 @@ void SceneRenderer::Draw(const ViewCamera& view, const FrameSettings& settings, 
   if (settings.shadows == ShadowMode::kPlanar) {
     if (r.scene.ground) {
       r.DrawPlanarShadows(view, settings, clip_from_world, projectors);
-    } else if (!r.planar_note_given) {
-      r.notes.push_back("planar shadows skipped: no ground plane was found in the scene");
-      r.planar_note_given = true;
+    } else {
+      r.NoteOnce("planar shadows skipped: no ground plane was found in the scene");
     }
   } else if (settings.shadows == ShadowMode::kBlob) {
     r.DrawBlobShadows(view, settings, clip_from_world);
   } else if (settings.shadows == ShadowMode::kVolume) {
     if (r.mesh->triangles > 0) {
       r.DrawVolumeShadows(view, settings, clip_from_world, projectors);
-    } else if (!r.volume_note_given) {
-      r.notes.push_back("shadow volumes skipped: they need a mesh, and there is only a point cloud");
-      r.volume_note_given = true;
+    } else {
+      r.NoteOnce("shadow volumes skipped: they need a mesh, and there is only a point cloud");
     }
   }
   r.lines.Use();

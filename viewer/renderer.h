@@ -130,6 +130,10 @@ class SceneRenderer {
   std::unique_ptr<Impl> impl_;
 };
 
+// Ground within this distance of the fitted plane receives planar and blob shadows (and is
+// "the ground" of --shadow-iou's split): 1% of the focus radius.
+float GroundBand(const ViewerScene& scene);
+
 // The level of detail a width x height frame draws: scene.display_mesh (when it has triangles)
 // if scene.mesh would give a triangle fewer than 16 pixels, else scene.mesh. Finer triangles
 // cost llvmpipe vertex and setup work without adding detail the atlas does not already show.

@@ -84,6 +84,7 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
   WindowState& s = *State(window);
   FrameSettings& settings = s.settings;
   const int sources = static_cast<int>(s.scene->sources.size());
+  const double azimuth = s.light_azimuth_deg, elevation = s.light_elevation_deg;
   switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(window, GLFW_TRUE); break;
     case GLFW_KEY_1: settings.shadows = ShadowMode::kNone; break;
@@ -103,16 +104,10 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_L:
       settings.light.type = settings.light.type == LightKind::kPoint ? LightKind::kDirectional : LightKind::kPoint;
       break;
-    case GLFW_KEY_LEFT: s.light_azimuth_deg -= 5; s.light_moved = std::chrono::steady_clock::now(); break;
-    case GLFW_KEY_RIGHT: s.light_azimuth_deg += 5; s.light_moved = std::chrono::steady_clock::now(); break;
-    case GLFW_KEY_UP:
-      s.light_elevation_deg = std::min(89.9, s.light_elevation_deg + 5);
-      s.light_moved = std::chrono::steady_clock::now();
-      break;
-    case GLFW_KEY_DOWN:
-      s.light_elevation_deg = std::max(0.1, s.light_elevation_deg - 5);
-      s.light_moved = std::chrono::steady_clock::now();
-      break;
+    case GLFW_KEY_LEFT: s.light_azimuth_deg -= 5; break;
+    case GLFW_KEY_RIGHT: s.light_azimuth_deg += 5; break;
+    case GLFW_KEY_UP: s.light_elevation_deg = std::min(89.9, s.light_elevation_deg + 5); break;
+    case GLFW_KEY_DOWN: s.light_elevation_deg = std::max(0.1, s.light_elevation_deg - 5); break;
     case GLFW_KEY_EQUAL: settings.exposure_stops += 0.25f; break;
     case GLFW_KEY_MINUS: settings.exposure_stops -= 0.25f; break;
     case GLFW_KEY_RIGHT_BRACKET: settings.pcf_radius = std::min(4, settings.pcf_radius + 1); break;
@@ -131,6 +126,7 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
       break;
     default: break;
   }
+  if (s.light_azimuth_deg != azimuth || s.light_elevation_deg != elevation) s.light_moved = std::chrono::steady_clock::now();
   UpdateLight(s);
 }
 
@@ -289,7 +285,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
         state.screenshot_requested = false;
         const std::filesystem::path path =
             options.screenshot_dir / ("view-" + std::to_string(++screenshots) + ".png");
-        WriteImage(path, renderer.Render(CurrentView(state, width, height), state.settings).color, PixelFormat::kUint8);
+        WriteImage(path, renderer.Render(view, state.settings).color, PixelFormat::kUint8);
         log("wrote " + path.string() + "\n");
       }
       for (const std::string& note : renderer.TakeNotes()) log(note + "\n");
