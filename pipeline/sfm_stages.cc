@@ -251,19 +251,27 @@ std::string ImageListText(const std::vector<std::string>& names) {
   return list;
 }
 
+// The raw model after one colmap bundle_adjuster run with `options`, through a scratch folder.
+SparseModel AdjustRawModel(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,
+                           const std::string& log_name, Progress& progress) {
+  const fs::path adjusted = paths.RefinedModelScratch();
+  RemoveAll(adjusted);
+  fs::create_directories(adjusted);
+  std::vector<std::string> arguments = {"--input_path", paths.RawModel().string(), "--output_path", adjusted.string()};
+  arguments.insert(arguments.end(), options.begin(), options.end());
+  colmap.Run("bundle_adjuster", arguments, paths.Log(log_name), log_name, 0, progress);
+  SparseModel model = ReadSparseModel(adjusted);
+  RemoveAll(adjusted);
+  return model;
+}
+
 // A final bundle adjustment that also frees the principal point, kept only when the point
 // stays near the image centre: where it is unobservable (a narrow arc of small images) it
 // drifts far off and the rotations with it.
 std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
                                  const ReconstructOptions& options, Progress& progress) {
-  const fs::path refined = paths.RefinedModelScratch();
-  RemoveAll(refined);
-  fs::create_directories(refined);
-  colmap.Run("bundle_adjuster",
-             {"--input_path", paths.RawModel().string(), "--output_path", refined.string(),
-              "--BundleAdjustment.refine_principal_point", "1"},
-             paths.Log("refine"), "refine", 0, progress);
-  const SparseModel model = ReadSparseModel(refined);
+  const SparseModel model =
+      AdjustRawModel(colmap, paths, {"--BundleAdjustment.refine_principal_point", "1"}, "refine", progress);
   double worst_offset = 0;
   for (const Camera& camera : model.Cameras()) {
     worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
@@ -279,20 +287,7 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
                   "principal point refined in a final bundle adjustment (%.1f%% off-centre)",
                   100 * worst_offset);
   }
-  RemoveAll(refined);
   return note;
-}
-
-// One bundle adjustment of the whole raw model: the hierarchical mapper merges its clusters'
-// models without one, as COLMAP's documentation warns.
-void AdjustMergedModel(const Colmap& colmap, const Workspace& paths, Progress& progress) {
-  const fs::path adjusted = paths.RefinedModelScratch();
-  RemoveAll(adjusted);
-  fs::create_directories(adjusted);
-  colmap.Run("bundle_adjuster", {"--input_path", paths.RawModel().string(), "--output_path", adjusted.string()},
-             paths.Log("adjust"), "adjust", 0, progress);
-  WriteSparseModel(ReadSparseModel(adjusted), paths.RawModel(), SparseFormat::kBinary);
-  RemoveAll(adjusted);
 }
 
 // The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
@@ -683,7 +678,10 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
     if (refine_principal_point) {
       notes.push_back(RefinePrincipalPoint(sfm.colmap, paths, sfm.options, sfm.progress));
     } else if (hierarchical) {
-      AdjustMergedModel(sfm.colmap, paths, sfm.progress);
+      // The hierarchical mapper merges its clusters' models without a final bundle adjustment,
+      // as COLMAP's documentation warns.
+      WriteSparseModel(AdjustRawModel(sfm.colmap, paths, {}, "adjust", sfm.progress), paths.RawModel(),
+                       SparseFormat::kBinary);
     }
   };
   return stage;
