@@ -226,7 +226,7 @@ class FusedCloud {
     head->second = index;
   }
 
-  std::vector<FusedPoint> Release() && { return std::move(points_); }
+  FusedPoints Release() && { return std::move(points_); }
 
  private:
   static constexpr uint32_t kNone = UINT32_MAX;
@@ -301,8 +301,8 @@ class FusedCloud {
 
   const double min_normal_cos_;
   const double max_relative_depth_;
-  std::vector<FusedPoint> points_;
-  std::vector<uint32_t> next_in_cell_;  // Per point: the next point of its cell, or kNone.
+  FusedPoints points_;
+  std::deque<uint32_t> next_in_cell_;  // Per point: the next point of its cell, or kNone.
   std::unordered_map<Cell, uint32_t, CellHash> cells_;  // The last point added to each cell.
   size_t reference_start_ = 0;
 };
@@ -377,8 +377,7 @@ void FusionOptions::Check() const {
                 "0 (no cap) or >= 64");
 }
 
-std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOptions& options,
-                                      Progress& progress) {
+FusedPoints FuseWorkspace(const fs::path& workspace, const FusionOptions& options, Progress& progress) {
   options.Check();
   const Workspace ws(workspace);
   const SparseModel model = ReadSparseModel(ws.Sparse());
@@ -402,7 +401,7 @@ std::vector<FusedPoint> FuseWorkspace(const fs::path& workspace, const FusionOpt
   return std::move(cloud).Release();
 }
 
-void WritePly(const fs::path& path, const std::vector<FusedPoint>& points) {
+void WritePly(const fs::path& path, const FusedPoints& points) {
   const std::string header = "ply\nformat binary_little_endian 1.0\nelement vertex " +
                              std::to_string(points.size()) +
                              "\nproperty float x\nproperty float y\nproperty float z\n"

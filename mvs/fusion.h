@@ -4,6 +4,7 @@
 // normals within 20 degrees), and kept when enough views agree.
 #include <array>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <vector>
 
@@ -38,16 +39,19 @@ struct FusedPoint {
   uint16_t views = 0;             // How many pixels were merged.
 };
 
+// Stored in chunks: the cloud grows without ever being copied whole, as a vector's doubling
+// would (it then holds the old and the new array, up to three times the points, at once).
+using FusedPoints = std::deque<FusedPoint>;
+
 // Reads <ws>/sparse, <ws>/images, <ws>/depth/<stem>.exr and the geometric normal maps under
 // <ws>/stereo/normal_maps (streamed: at most max_neighbours + 1 views in memory, each at the
 // working resolution), colors
 // corrected by <ws>/color_gains.json when present. Views without a depth map are left out.
 // Deterministic.
-std::vector<FusedPoint> FuseWorkspace(const std::filesystem::path& workspace,
-                                      const FusionOptions& options, Progress& progress);
+FusedPoints FuseWorkspace(const std::filesystem::path& workspace, const FusionOptions& options, Progress& progress);
 
 // Binary little-endian PLY with x y z nx ny nz (float) and red green blue (uchar), written
 // atomically. The format COLMAP's fused.ply uses.
-void WritePly(const std::filesystem::path& path, const std::vector<FusedPoint>& points);
+void WritePly(const std::filesystem::path& path, const FusedPoints& points);
 
 }  // namespace parallax
