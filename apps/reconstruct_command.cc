@@ -87,13 +87,22 @@ void RegisterReconstructCommand(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(matchers, CLI::ignore_case));
   const std::map<std::string, MapperChoice> mappers = {{"auto", MapperChoice::kAuto},
                                                        {"incremental", MapperChoice::kIncremental},
-                                                       {"hierarchical", MapperChoice::kHierarchical}};
+                                                       {"hierarchical", MapperChoice::kHierarchical},
+                                                       {"keys", MapperChoice::kKeyPhotos}};
   command->add_option("--mapper", arguments->options.mapper,
-                      "auto (default): incremental (one model, image by image) up to " +
+                      "auto (default): past " + std::to_string(ReconstructOptions().exhaustive_limit) +
+                          " photos, keys (an incremental model of key photos, the others "
+                          "registered to it) where consecutive photos see nearly the same; else "
+                          "incremental (one model, image by image) up to " +
                           std::to_string(ReconstructOptions().hierarchical_limit) +
-                          " photos; past that hierarchical (clusters of the match graph mapped "
-                          "apart, then merged)")
+                          " photos and hierarchical (clusters of the match graph mapped "
+                          "apart, then merged) past that")
       ->transform(CLI::CheckedTransformer(mappers, CLI::ignore_case));
+  command->add_option("--key-photo-share", arguments->options.key_photo_shared,
+                      "with key photos: the share of their features consecutive keys still share "
+                      "in verified matches (default " + std::to_string(ReconstructOptions().key_photo_shared).substr(0, 4) +
+                          "; lower: fewer keys, less memory and time, less accurate poses)")
+      ->check(CLI::Range(0.01, 1.0));
   command->add_option("--camera-model", arguments->camera_model,
                       "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");
   command->add_option("--intrinsics", arguments->intrinsics,

@@ -55,6 +55,13 @@ int64_t CountDescriptors(const std::filesystem::path& database) {
   return count;
 }
 
+std::map<std::string, int> ReadFeatureCounts(const std::filesystem::path& database) {
+  std::map<std::string, int> counts;
+  ForEachRow(database, "SELECT images.name, keypoints.rows FROM images JOIN keypoints USING (image_id)",
+             [&](sqlite3_stmt* row) { counts[TextColumn(row, 0)] = sqlite3_column_int(row, 1); });
+  return counts;
+}
+
 std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database) {
   std::map<int64_t, std::string> names;
   ForEachRow(database, "SELECT image_id, name FROM images", [&](sqlite3_stmt* row) {

@@ -37,6 +37,10 @@ struct VerifiedPair {
 // naming the file if it cannot be read.
 int64_t CountDescriptors(const std::filesystem::path& database);
 
+// Each image's number of features (keypoints), by name. Throws BadInputError naming the file if
+// it cannot be read.
+std::map<std::string, int> ReadFeatureCounts(const std::filesystem::path& database);
+
 // Every verified pair, in the database's order. Throws BadInputError naming the file if it
 // cannot be read.
 std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database);

@@ -43,6 +43,8 @@ class Workspace {
   std::filesystem::path Sfm() const { return root_ / "sfm"; }
   std::filesystem::path Database() const { return Sfm() / "database.db"; }
   std::filesystem::path ImageList() const { return Sfm() / "image_list.txt"; }
+  // The key photos the mapper starts from in a dense ordered capture (pipeline/key_photos.h).
+  std::filesystem::path KeyPhotoList() const { return Sfm() / "key_photos.txt"; }
   // The photos as COLMAP reads them, when some had to be converted (sfm/photo_conversion.h).
   std::filesystem::path ReadablePhotos() const { return Sfm() / "photos"; }
   std::filesystem::path KnownModel() const { return Sfm() / "known"; }

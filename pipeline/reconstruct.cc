@@ -220,6 +220,8 @@ void ReconstructOptions::Check() const {
   RequireOption(hierarchical_limit >= 2, "ReconstructOptions.hierarchical_limit", hierarchical_limit, ">= 2");
   RequireOption(hierarchical_cluster_images >= 10, "ReconstructOptions.hierarchical_cluster_images",
                 hierarchical_cluster_images, ">= 10");
+  RequireOption(key_photo_shared > 0 && key_photo_shared <= 1, "ReconstructOptions.key_photo_shared",
+                key_photo_shared, "(0, 1]");
   RequireOption(sequential_overlap >= 2, "ReconstructOptions.sequential_overlap", sequential_overlap, ">= 2");
   RequireOption(retrieval_images >= 1, "ReconstructOptions.retrieval_images", retrieval_images, ">= 1");
   RequireOption(ordered_share > 0 && ordered_share <= 1, "ReconstructOptions.ordered_share", ordered_share,
@@ -266,7 +268,6 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                        MatcherFor(options, num_images), progress};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = PlannedMatcher(options, num_images);
-  summary.mapper = DescribeMapper(options, num_images, known.has_value());
 
   const std::string conversions = DescribeConversions(photos, paths);
   if (!conversions.empty()) summary.notes.push_back(conversions);
@@ -285,7 +286,9 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     const std::string matched = ReadFileBytes(paths.MatchedMarker());
     if (matched != matches.key) summary.matcher = matched;
   }
-  const Stage mapper = MapperStage(sfm, matches.key, summary.notes);
+  const MapperPlan mapper_plan = PlanMapper(sfm);
+  summary.mapper = mapper_plan.description;
+  const Stage mapper = MapperStage(sfm, mapper_plan, matches.key, summary.notes);
   graph.Run(mapper);
   if (options.dry_run) {
     graph.Run(UndistortStage(sfm, mapper.key, nullptr));

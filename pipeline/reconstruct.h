@@ -34,10 +34,13 @@ enum class MatcherChoice {
 
 // How the registered model is grown from the matches.
 enum class MapperChoice {
-  kAuto,          // Incremental up to `hierarchical_limit` images, hierarchical past it.
+  kAuto,          // Past `exhaustive_limit` images, key photos where the capture is dense and
+                  // ordered; else incremental up to `hierarchical_limit` images, hierarchical past it.
   kIncremental,   // COLMAP's mapper: one model, image by image, bundle adjusted as it grows.
   kHierarchical,  // COLMAP's hierarchical_mapper: overlapping clusters of the match graph
                   // mapped apart, then merged.
+  kKeyPhotos,     // COLMAP's mapper on the key photos (pipeline/key_photos.h), the others then
+                  // registered to their model.
 };
 
 enum class StereoMethod { kPatchMatch, kSgbm };
@@ -67,6 +70,9 @@ struct ReconstructOptions {
   int hierarchical_limit = 800;
   // Most images in one of the hierarchical mapper's clusters.
   int hierarchical_cluster_images = 100;
+  // Consecutive key photos share at least this share of their features in verified matches
+  // (docs/scale.md: the plaza's neighbours 7 degrees apart share 33%).
+  double key_photo_shared = 0.3;
   // colmap's SequentialMatching.overlap: each image is matched with the next overlap - 1
   // images in name order (and those a power of two ahead).
   int sequential_overlap = 20;

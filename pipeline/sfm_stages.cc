@@ -1,6 +1,7 @@
 #include "pipeline/sfm_stages.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <map>
@@ -16,6 +17,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/hash.h"
+#include "pipeline/key_photos.h"
 #include "sfm/photo_conversion.h"
 #include "sfm/undistort.h"
 
@@ -288,6 +290,24 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
                   100 * worst_offset);
   }
   return note;
+}
+
+// The raw model with every other photo the database can place registered to its points (colmap
+// image_registrator: each photo's pose from its matches with the model's points; no points are
+// added and the model is not adjusted).
+SparseModel RegisterOtherPhotos(const SfmContext& sfm, const std::vector<std::string>& options) {
+  const Workspace& paths = sfm.workspace;
+  const fs::path registered = paths.RefinedModelScratch();
+  RemoveAll(registered);
+  fs::create_directories(registered);
+  std::vector<std::string> arguments = {"--database_path", paths.Database().string(), "--input_path",
+                                        paths.RawModel().string(), "--output_path", registered.string()};
+  arguments.insert(arguments.end(), options.begin(), options.end());
+  sfm.colmap.Run("image_registrator", arguments, paths.Log("register"), "register",
+                 static_cast<int>(sfm.photos.photos.size()), sfm.progress);
+  SparseModel model = ReadSparseModel(registered);
+  RemoveAll(registered);
+  return model;
 }
 
 // The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
@@ -599,25 +619,69 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
   return stage;
 }
 
-bool MapsHierarchically(const ReconstructOptions& options, int num_images) {
-  if (options.mapper == MapperChoice::kAuto) return num_images > options.hierarchical_limit;
-  return options.mapper == MapperChoice::kHierarchical;
-}
+namespace {
 
-std::string DescribeMapper(const ReconstructOptions& options, int num_images, bool known) {
-  if (known) return "point_triangulator (known cameras: only the points are triangulated)";
-  const std::string chosen = options.mapper == MapperChoice::kAuto ? ", chosen automatically: " : "";
-  if (!MapsHierarchically(options, num_images)) {
-    return "incremental (one model grown image by image)" + chosen +
-           (chosen.empty() ? "" : "at most " + std::to_string(options.hierarchical_limit) + " images");
+std::string PercentText(double share) { return std::to_string(static_cast<int>(std::lround(100 * share))) + "%"; }
+
+// Incremental or hierarchical, by the user's choice or the photo count.
+MapperPlan PlanByCount(const ReconstructOptions& options, int num_images) {
+  const bool automatic = options.mapper == MapperChoice::kAuto;
+  const bool hierarchical = options.mapper == MapperChoice::kHierarchical ||
+                            (options.mapper == MapperChoice::kAuto && num_images > options.hierarchical_limit);
+  const std::string chosen = automatic ? ", chosen automatically: " : "";
+  if (!hierarchical) {
+    return {MapperChoice::kIncremental, {},
+            "incremental (one model grown image by image)" + chosen +
+                (chosen.empty() ? "" : "at most " + std::to_string(options.hierarchical_limit) + " images")};
   }
-  return "hierarchical (clusters of at most " + std::to_string(options.hierarchical_cluster_images) +
-         " images mapped apart, then merged)" + chosen +
-         (chosen.empty() ? "" : std::to_string(num_images) + " images, more than " +
-                                    std::to_string(options.hierarchical_limit) + " for one incremental model");
+  return {MapperChoice::kHierarchical, {},
+          "hierarchical (clusters of at most " + std::to_string(options.hierarchical_cluster_images) +
+              " images mapped apart, then merged)" + chosen +
+              (chosen.empty() ? "" : std::to_string(num_images) + " images, more than " +
+                                         std::to_string(options.hierarchical_limit) + " for one incremental model")};
 }
 
-Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
+}  // namespace
+
+MapperPlan PlanMapper(const SfmContext& sfm) {
+  const ReconstructOptions& options = sfm.options;
+  const int num_images = static_cast<int>(sfm.photos.photos.size());
+  if (sfm.known) {
+    return {MapperChoice::kIncremental, {}, "point_triangulator (known cameras: only the points are triangulated)"};
+  }
+  const bool may_use_keys = options.mapper == MapperChoice::kKeyPhotos ||
+                            (options.mapper == MapperChoice::kAuto && num_images > options.exhaustive_limit);
+  if (!may_use_keys) return PlanByCount(options, num_images);
+  const std::string rule = "consecutive keys share at least " + PercentText(options.key_photo_shared) +
+                           " of their features in verified matches";
+  const fs::path database = sfm.workspace.Database();
+  if (!fs::exists(database)) {
+    return {MapperChoice::kKeyPhotos, {},
+            "key photos where neighbours in name order see nearly the same (" + rule + "), else " +
+                PlanByCount(options, num_images).description + "; decided from the matches"};
+  }
+  const KeyPhotoOptions key_options{options.sequential_overlap - 1, options.key_photo_shared};
+  std::vector<std::string> keys =
+      KeyPhotos(PhotoNames(sfm.photos), ReadVerifiedPairs(database), ReadFeatureCounts(database), key_options);
+  if (static_cast<int>(keys.size()) == num_images) {
+    MapperPlan plan = PlanByCount(options, num_images);
+    plan.description += "; every photo is a key photo (consecutive photos share less than " +
+                        PercentText(options.key_photo_shared) + " of their features)";
+    return plan;
+  }
+  const std::string chosen = options.mapper == MapperChoice::kAuto
+                                 ? ", chosen automatically: " + std::to_string(num_images) + " images, more than " +
+                                       std::to_string(options.exhaustive_limit) + ", and neighbours in name order "
+                                       "see nearly the same"
+                                 : "";
+  const int registered = num_images - static_cast<int>(keys.size());
+  return {MapperChoice::kKeyPhotos, std::move(keys),
+          "key photos (one incremental model of " + std::to_string(num_images - registered) + " key photos, " + rule +
+              "; the other " + std::to_string(registered) +
+              " registered to it)" + chosen};
+}
+
+Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::string& matches_key,
                   std::vector<std::string>& notes) {
   const Workspace& paths = sfm.workspace;
   const int num_images = static_cast<int>(sfm.photos.photos.size());
@@ -625,7 +689,8 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       sfm.camera.sharing == CameraSharing::kAll && !sfm.camera.fixed_intrinsics &&
       num_images >= sfm.options.refine_principal_point_min_images;
   Stage stage;
-  const bool hierarchical = !sfm.known && MapsHierarchically(sfm.options, num_images);
+  const bool hierarchical = !sfm.known && plan.mapper == MapperChoice::kHierarchical;
+  const bool key_photos = !sfm.known && plan.mapper == MapperChoice::kKeyPhotos;
   stage.name = sfm.known ? "triangulate" : "mapper";
   Hasher hasher;
   hasher.Add(matches_key)
@@ -634,9 +699,11 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
   // The incremental mapper keeps the keys it had before there was a choice.
   if (hierarchical) hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images));
+  if (key_photos) hasher.Add("key photos").Add(ImageListText(plan.key_photos));
   stage.key = hasher.Hex();
   stage.outputs = {paths.RawModel()};
-  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, name = stage.name] {
+  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, key_photos,
+               keys = plan.key_photos, name = stage.name] {
     const fs::path models = paths.Models().string() + ".tmp";
     const TemporaryOutput temporary(models);
     RemoveAll(models);
@@ -665,16 +732,23 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
                                            std::to_string(sfm.options.hierarchical_cluster_images),
                                            "--image_overlap",
                                            std::to_string(sfm.options.hierarchical_cluster_images / 2)});
+      } else if (key_photos) {
+        WriteFileAtomically(paths.KeyPhotoList(), ImageListText(keys));
+        arguments.insert(arguments.end(), {"--image_list_path", paths.KeyPhotoList().string()});
       } else {
         arguments.insert(arguments.end(), {"--image_list_path", paths.ImageList().string()});
       }
       if (sfm.camera.fixed_intrinsics) {
         arguments.insert(arguments.end(), fixed_intrinsics.begin(), fixed_intrinsics.end());
       }
-      RunMapper(sfm, hierarchical ? "hierarchical_mapper" : "mapper", arguments, name, num_images);
+      RunMapper(sfm, hierarchical ? "hierarchical_mapper" : "mapper", arguments, name,
+                key_photos ? static_cast<int>(keys.size()) : num_images);
     }
     Replace(models, paths.Models());
     WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);
+    // With key photos, the principal point is refined on their model: the photos registered
+    // to it afterwards are not adjusted (an adjustment of them all costs twice the memory and
+    // made the poses worse on the plaza, docs/scale.md).
     if (refine_principal_point) {
       notes.push_back(RefinePrincipalPoint(sfm.colmap, paths, sfm.options, sfm.progress));
     } else if (hierarchical) {
@@ -682,6 +756,11 @@ Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
       // as COLMAP's documentation warns.
       WriteSparseModel(AdjustRawModel(sfm.colmap, paths, {}, "adjust", sfm.progress), paths.RawModel(),
                        SparseFormat::kBinary);
+    }
+    if (key_photos) {
+      WriteSparseModel(RegisterOtherPhotos(sfm, sfm.camera.fixed_intrinsics ? fixed_intrinsics
+                                                                             : std::vector<std::string>{}),
+                       paths.RawModel(), SparseFormat::kBinary);
     }
   };
   return stage;

@@ -74,11 +74,17 @@ MatcherChoice MatcherFor(const ReconstructOptions& options, int num_images);
 // writes what it did into Workspace::MatchedMarker.
 std::string PlannedMatcher(const ReconstructOptions& options, int num_images);
 
-// Whether `num_images` photos are mapped hierarchically (--mapper, or past the limit).
-bool MapsHierarchically(const ReconstructOptions& options, int num_images);
-// report.json's sentence for the mapper, and why (`known`: --known-cameras, which only
-// triangulates).
-std::string DescribeMapper(const ReconstructOptions& options, int num_images, bool known);
+// How the model is mapped: the user's choice, or the automatic one and why.
+struct MapperPlan {
+  MapperChoice mapper = MapperChoice::kIncremental;  // Never kAuto.
+  std::vector<std::string> key_photos;                // kKeyPhotos: in name order.
+  std::string description;                            // report.json's sentence.
+};
+
+// The plan for the photos of `sfm`. Key photos are chosen from the verified matches, so they
+// are decided only once the database exists (a dry run before matching says so); with
+// --known-cameras there is nothing to map, only points to triangulate.
+MapperPlan PlanMapper(const SfmContext& sfm);
 
 // `photos_key` is PhotosStage's key.
 Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key);
@@ -88,7 +94,7 @@ Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key
 Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
                    const std::string& vocabulary_tree_key);
 // Notes the mapper's decisions (a principal-point refinement kept or rejected) in `notes`.
-Stage MapperStage(const SfmContext& sfm, const std::string& matches_key,
+Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::string& matches_key,
                   std::vector<std::string>& notes);
 // Undistortion into the workspace layout (PINHOLE photos and model). `raw_model` is the
 // mapper's model, or null in a dry run (the stage is then only planned).

@@ -5,3 +5,4 @@ set_tests_properties(ReconstructCli.PhotosOfTwoSizesGetOneCameraPerSize PROPERTI
 set_tests_properties(Slurm.JobArraysOnARealClusterWriteWhatALocalRunWrites PROPERTIES LABELS "cli;slow")
 set_tests_properties(Matching.OrderedPhotosMatchSequentiallyShuffledOnesByRetrieval PROPERTIES LABELS "pipeline;slow")
 set_tests_properties(Mapping.PastTheLimitClustersAreMappedApartAndMerged PROPERTIES LABELS "pipeline;slow")
+set_tests_properties(Mapping.KeyPhotosAreMappedAndTheOthersRegisteredToThem PROPERTIES LABELS "pipeline;slow")

@@ -2,6 +2,7 @@
 // (24 photos 15 degrees apart on a ring; every other one is too sparse for SfM at fast
 // quality): sequential for photos in capture order, retrieval when their names are shuffled,
 // both from a vocabulary tree built from the photos.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "colmap/database.h"
 #include "core/atomic_file.h"
@@ -17,6 +19,8 @@
 #include "core/workspace.h"
 #include "eval/evaluate.h"
 #include "pipeline/reconstruct.h"
+#include "synth/scene.h"
+#include "synth/synth.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -136,6 +140,64 @@ TEST(Mapping, PastTheLimitClustersAreMappedApartAndMerged) {
               poses.rotation_error_mean_deg, one_model.rotation_error_mean_deg);
   EXPECT_EQ(one_model.registered, 24);
   EXPECT_LT(one_model.rotation_error_mean_deg, 0.2);
+}
+
+}  // namespace
+}  // namespace parallax
+
+namespace parallax {
+namespace {
+
+// The courtyard from 72 cameras 5 degrees apart at 320x240: neighbours share about 43% of their
+// features, photos two apart 25%.
+void RenderDenseCourtyard(const fs::path& folder) {
+  nlohmann::json scene = nlohmann::json::parse(ReadFileBytes(kCourtyard / "scene.json"));
+  scene["image"] = {{"width", 320}, {"height", 240}, {"focal_px", 260}, {"supersampling", 1}};
+  scene["cameras"]["training"][0]["count"] = 72;
+  scene["cameras"]["novel"] = nlohmann::json::array();
+  SilentProgress progress;
+  RenderSceneFolder(ParseSceneJson(scene.dump(), "dense courtyard"), scene.dump(), folder, {}, progress);
+}
+
+// Key photos that share 20% of their features, every other photo: the mapper grows one model
+// from them, the others are registered to it, and every photo ends up in the model with its
+// true pose. Matched sequentially with the next 4 photos (fewer pairs than exhaustive).
+TEST(Mapping, KeyPhotosAreMappedAndTheOthersRegisteredToThem) {
+  const TempDir scene, workspace;
+  RenderDenseCourtyard(scene.Path());
+  ReconstructOptions options;
+  options.quality = Quality::kFast;
+  options.estimate_depth = false;
+  options.matcher = MatcherChoice::kSequential;
+  options.sequential_overlap = 5;
+  options.mapper = MapperChoice::kKeyPhotos;
+  options.key_photo_shared = 0.2;
+  SilentProgress progress;
+  const ReconstructSummary summary = Reconstruct(scene.Path() / "images", workspace.Path(), options, progress);
+  std::printf("[ measure ] %s\n", summary.mapper.c_str());
+  ASSERT_EQ(summary.mapper.rfind("key photos (one incremental model of ", 0), 0u) << summary.mapper;
+  const std::string keys = ReadFileBytes(Workspace(workspace.Path()).KeyPhotoList());
+  const auto key_count = std::count(keys.begin(), keys.end(), '\n');
+  EXPECT_GE(key_count, 30);
+  EXPECT_LE(key_count, 50);
+  EXPECT_TRUE(fs::exists(Workspace(workspace.Path()).Log("register")));
+  const PoseEvaluation poses = EvaluatePoses(ReadSparseModel(workspace.Path() / "sparse"),
+                                             ReadSparseModel(SceneFolder{scene.Path()}.Training().sparse));
+  std::printf("[ measure ] %d key photos; rotation error %.3f deg\n", static_cast<int>(key_count),
+              poses.rotation_error_mean_deg);
+  EXPECT_EQ(poses.registered, 72);
+  EXPECT_LT(poses.rotation_error_mean_deg, 0.3);
+  EXPECT_LT(summary.mean_reprojection_error_px, 1.0);
+
+  // Run again, nothing runs; forced incremental, only the mapper runs again.
+  const ReconstructSummary again = Reconstruct(scene.Path() / "images", workspace.Path(), options, progress);
+  for (const StageRecord& stage : again.stages) EXPECT_TRUE(stage.skipped) << stage.name;
+  EXPECT_EQ(again.mapper, summary.mapper);
+  options.mapper = MapperChoice::kIncremental;
+  const ReconstructSummary incremental = Reconstruct(scene.Path() / "images", workspace.Path(), options, progress);
+  EXPECT_EQ(incremental.mapper, "incremental (one model grown image by image)");
+  EXPECT_FALSE(StageNamed(incremental, "mapper").skipped);
+  EXPECT_TRUE(StageNamed(incremental, "matches").skipped);
 }
 
 }  // namespace
