@@ -100,8 +100,9 @@ void RegisterReconstructCommand(CLI::App& app) {
       ->transform(CLI::CheckedTransformer(mappers, CLI::ignore_case));
   command->add_option("--key-photo-share", arguments->options.key_photo_shared,
                       "with key photos: the share of their features consecutive keys still share "
-                      "in verified matches (default " + std::to_string(ReconstructOptions().key_photo_shared).substr(0, 4) +
-                          "; lower: fewer keys, less memory and time, less accurate poses)")
+                      "in verified matches (lower: fewer keys, less memory and time, less "
+                      "accurate poses)")
+      ->capture_default_str()
       ->check(CLI::Range(0.01, 1.0));
   command->add_option("--camera-model", arguments->camera_model,
                       "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");
