@@ -1,5 +1,5 @@
 #pragma once
-// Key photos of a dense ordered capture (docs/scale.md, "Mapping past a size"): the photos the
+// Key photos of a dense ordered capture (docs/scale.md, "Key photos"): the photos the
 // incremental mapper grows its model from when neighbours in name order see nearly the same
 // thing. The other photos are registered to the key photos' model afterwards, so the mapper's
 // memory and time follow the scene, not the number of photos taken of it.

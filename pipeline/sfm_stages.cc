@@ -253,18 +253,25 @@ std::string ImageListText(const std::vector<std::string>& names) {
   return list;
 }
 
-// The raw model after one colmap bundle_adjuster run with `options`, through a scratch folder.
+// The model colmap `command` writes from the raw model (`--input_path`) with `arguments`, through a
+// scratch folder. `total`: the units of work its progress lines count (0: none).
+SparseModel RunOnRawModel(const Colmap& colmap, const Workspace& paths, const std::string& command,
+                          std::vector<std::string> arguments, const std::string& log_name, int total,
+                          Progress& progress) {
+  const fs::path output = paths.RefinedModelScratch();
+  RemoveAll(output);
+  fs::create_directories(output);
+  arguments.insert(arguments.end(), {"--input_path", paths.RawModel().string(), "--output_path", output.string()});
+  colmap.Run(command, arguments, paths.Log(log_name), log_name, total, progress);
+  SparseModel model = ReadSparseModel(output);
+  RemoveAll(output);
+  return model;
+}
+
+// The raw model after one colmap bundle_adjuster run with `options`.
 SparseModel AdjustRawModel(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,
                            const std::string& log_name, Progress& progress) {
-  const fs::path adjusted = paths.RefinedModelScratch();
-  RemoveAll(adjusted);
-  fs::create_directories(adjusted);
-  std::vector<std::string> arguments = {"--input_path", paths.RawModel().string(), "--output_path", adjusted.string()};
-  arguments.insert(arguments.end(), options.begin(), options.end());
-  colmap.Run("bundle_adjuster", arguments, paths.Log(log_name), log_name, 0, progress);
-  SparseModel model = ReadSparseModel(adjusted);
-  RemoveAll(adjusted);
-  return model;
+  return RunOnRawModel(colmap, paths, "bundle_adjuster", options, log_name, 0, progress);
 }
 
 // A final bundle adjustment that also frees the principal point, kept only when the point
@@ -296,18 +303,10 @@ std::string RefinePrincipalPoint(const Colmap& colmap, const Workspace& paths,
 // image_registrator: each photo's pose from its matches with the model's points; no points are
 // added and the model is not adjusted).
 SparseModel RegisterOtherPhotos(const SfmContext& sfm, const std::vector<std::string>& options) {
-  const Workspace& paths = sfm.workspace;
-  const fs::path registered = paths.RefinedModelScratch();
-  RemoveAll(registered);
-  fs::create_directories(registered);
-  std::vector<std::string> arguments = {"--database_path", paths.Database().string(), "--input_path",
-                                        paths.RawModel().string(), "--output_path", registered.string()};
+  std::vector<std::string> arguments = {"--database_path", sfm.workspace.Database().string()};
   arguments.insert(arguments.end(), options.begin(), options.end());
-  sfm.colmap.Run("image_registrator", arguments, paths.Log("register"), "register",
-                 static_cast<int>(sfm.photos.photos.size()), sfm.progress);
-  SparseModel model = ReadSparseModel(registered);
-  RemoveAll(registered);
-  return model;
+  return RunOnRawModel(sfm.colmap, sfm.workspace, "image_registrator", arguments, "register",
+                       static_cast<int>(sfm.photos.photos.size()), sfm.progress);
 }
 
 // The model folders the mapper wrote, in name order. Throws BadInputError when there is none.
@@ -674,11 +673,10 @@ MapperPlan PlanMapper(const SfmContext& sfm) {
                                        std::to_string(options.exhaustive_limit) + ", and neighbours in name order "
                                        "see nearly the same"
                                  : "";
-  const int registered = num_images - static_cast<int>(keys.size());
+  const int key_count = static_cast<int>(keys.size());
   return {MapperChoice::kKeyPhotos, std::move(keys),
-          "key photos (one incremental model of " + std::to_string(num_images - registered) + " key photos, " + rule +
-              "; the other " + std::to_string(registered) +
-              " registered to it)" + chosen};
+          "key photos (one incremental model of " + std::to_string(key_count) + " key photos, " + rule +
+              "; the other " + std::to_string(num_images - key_count) + " registered to it)" + chosen};
 }
 
 Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::string& matches_key,

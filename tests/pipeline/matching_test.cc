@@ -142,11 +142,6 @@ TEST(Mapping, PastTheLimitClustersAreMappedApartAndMerged) {
   EXPECT_LT(one_model.rotation_error_mean_deg, 0.2);
 }
 
-}  // namespace
-}  // namespace parallax
-
-namespace parallax {
-namespace {
 
 // The courtyard from 72 cameras 5 degrees apart at 320x240: neighbours share about 43% of their
 // features, photos two apart 25%.
