@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "core/sparse_model_formats.h"
 
 namespace parallax {
@@ -232,6 +233,13 @@ SparseModel ReadSparseModel(const fs::path& dir, SparseFormat format) {
     throw BadInputError((dir / ("images" + extension)).string() + " and points3D" + extension +
                         " disagree: " + *broken);
   }
+  return model;
+}
+
+SparseModel ReadSparseModelWithoutKeypoints(const fs::path& dir) {
+  SparseModel model = ReadSparseModel(dir);
+  for (SparseImage& image : model.MutableImages()) std::vector<Point2D>().swap(image.points2d);
+  ReturnFreedMemory();  // Else the keypoints' pages stay resident through the stage that reads it.
   return model;
 }
 

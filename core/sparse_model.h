@@ -90,6 +90,11 @@ std::optional<SparseFormat> DetectSparseFormat(const std::filesystem::path& dir)
 SparseModel ReadSparseModel(const std::filesystem::path& dir);
 SparseModel ReadSparseModel(const std::filesystem::path& dir, SparseFormat format);
 
+// The model without each image's 2D points (all its keypoints: most of the model's memory once
+// there are hundreds of photos), for the dense stages, which need the cameras, poses and tracks
+// only. The tracks' point2d_idx then index nothing.
+SparseModel ReadSparseModelWithoutKeypoints(const std::filesystem::path& dir);
+
 // Writes cameras, images and points3D in `format` into `dir` (created if missing). Each file is
 // written to a temporary name and renamed. Throws BadInputError if `dir` is not writable.
 void WriteSparseModel(const SparseModel& model, const std::filesystem::path& dir,

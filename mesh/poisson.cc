@@ -98,7 +98,7 @@ TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius)
 // The cameras, each photo read (and corrected by its color gain) only when the texture needs it.
 std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
   const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
   const ColorGains gains = ReadWorkspaceColorGains(workspace);
   std::vector<TextureView> views;
   for (const SparseImage& image : model.Images()) {

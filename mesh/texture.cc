@@ -130,6 +130,69 @@ double MedianEdgePixels(const std::vector<Eigen::Vector3f>& vertices,
   return static_cast<double>(edges[edges.size() / 2]);
 }
 
+// Triangles in pairs, a pair to a cell of (texels + 5) x (texels + 2) texels: the first in the
+// cell's lower left, its legs along the cell's edges, the second turned half a turn in the upper
+// right. Each has a texel of margin to the cell's edges and three texels of gap to the other
+// along the diagonal, so bilinear filtering at a point of one triangle reads only texels of its
+// own side (in cell texels (i, j), the first's are those with i + j <= texels + 2), and every
+// texel shows its side's triangle, at its nearest point. Half a square per triangle, where one
+// triangle to a square cell left the other half unused.
+struct AtlasLayout {
+  int texels = 0;  // Along each triangle's legs.
+  int columns = 0, rows = 0;
+
+  int CellWidth() const { return texels + 5; }
+  int CellHeight() const { return texels + 2; }
+  int Width() const { return columns * CellWidth(); }
+  int Height() const { return rows * CellHeight(); }
+  int LongerSide() const { return std::max(Width(), Height()); }
+  bool OwnedBySecond(int i, int j) const { return i + j > texels + 2; }
+  // Corner c of triangle t in atlas texels (x right, y down); corner 0 is where its legs meet.
+  Eigen::Vector2f Corner(size_t t, int c) const {
+    const bool second = t % 2 == 1;
+    const Eigen::Vector2f cell = CellOrigin(t).cast<float>();
+    const Eigen::Vector2f origin = cell + (second ? Eigen::Vector2f(static_cast<float>(texels + 4), static_cast<float>(texels + 1))
+                                                  : Eigen::Vector2f(1, 1));
+    const float leg = second ? -static_cast<float>(texels) : static_cast<float>(texels);
+    return c == 0 ? origin : c == 1 ? origin + Eigen::Vector2f(leg, 0) : origin + Eigen::Vector2f(0, leg);
+  }
+  // The atlas pixel of texel (i, j) of triangle t's cell.
+  size_t TexelIndex(size_t t, int i, int j) const {
+    const Eigen::Vector2i texel = CellOrigin(t) + Eigen::Vector2i(i, j);
+    return static_cast<size_t>(texel.y()) * static_cast<size_t>(Width()) + static_cast<size_t>(texel.x());
+  }
+
+ private:
+  Eigen::Vector2i CellOrigin(size_t t) const {
+    const auto cell = static_cast<int>(t / 2);
+    return {cell % columns * CellWidth(), cell / columns * CellHeight()};
+  }
+};
+
+// About as many texels down as across.
+AtlasLayout LayoutFor(size_t triangles, int texels) {
+  AtlasLayout layout;
+  layout.texels = texels;
+  const double cells = std::max(1.0, std::ceil(static_cast<double>(triangles) / 2));
+  layout.columns = std::max(1, static_cast<int>(std::ceil(std::sqrt(cells * layout.CellHeight() / layout.CellWidth()))));
+  layout.rows = static_cast<int>(std::ceil(cells / layout.columns));
+  return layout;
+}
+
+// For each view, the triangles that rank it and with what weight: (score / best score)^exponent.
+std::vector<std::vector<std::pair<size_t, float>>> UsesPerView(const std::vector<Candidates>& ranked, size_t views,
+                                                               double blend_exponent) {
+  std::vector<std::vector<std::pair<size_t, float>>> uses(views);
+  for (size_t t = 0; t < ranked.size(); ++t) {
+    for (const Candidate& candidate : ranked[t]) {
+      if (candidate.view < 0) break;
+      const double ratio = static_cast<double>(candidate.score / ranked[t][0].score);
+      uses[static_cast<size_t>(candidate.view)].emplace_back(t, static_cast<float>(std::pow(ratio, blend_exponent)));
+    }
+  }
+  return uses;
+}
+
 // The views' photos, one at a time: each photo's weighted samples added to the texels of the
 // triangles that ranked it (in the atlas itself), then the texels divided by their weights.
 class TexelAccumulator {
@@ -192,41 +255,41 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
   for (const TextureView& view : views) {
     if (view.camera.HasDistortion()) throw std::invalid_argument("texture: views must be distortion-free");
   }
-  const std::vector<Candidates> ranked = RankViews(vertices, triangles, views, options);
+  // Which triangles rank each photo, with their weights; the ranking itself is freed before the
+  // atlas is made.
+  std::vector<std::vector<std::pair<size_t, float>>> uses;
+  double median_edge_pixels = 0;
+  {
+    const std::vector<Candidates> ranked = RankViews(vertices, triangles, views, options);
+    median_edge_pixels = MedianEdgePixels(vertices, triangles, views, ranked);
+    uses = UsesPerView(ranked, views.size(), options.blend_exponent);
+    summary.untextured_triangles = static_cast<size_t>(
+        std::count_if(ranked.begin(), ranked.end(), [](const Candidates& c) { return c[0].view < 0; }));
+  }
 
-  // One square cell per triangle: the triangle fills the lower-left half of the cell's inner
-  // part, one texel of margin all round. Texels outside the triangle repeat its nearest point,
-  // so bilinear filtering never reaches a neighbour's colors.
-  const double cells_per_side = std::ceil(std::sqrt(static_cast<double>(std::max<size_t>(triangles.size(), 1))));
-  const int largest_edge = static_cast<int>(options.max_atlas_size / cells_per_side) - 2;
-  const int texels = std::clamp(static_cast<int>(std::ceil(MedianEdgePixels(vertices, triangles, views, ranked))),
-                                options.min_texels_per_edge,
-                                std::max(options.min_texels_per_edge, std::min(options.max_texels_per_edge, largest_edge)));
-  const int cell = texels + 2;
-  const int columns = static_cast<int>(cells_per_side);
-  const int rows = static_cast<int>((static_cast<int>(triangles.size()) + columns - 1) / columns);
+  int texels = std::clamp(static_cast<int>(std::ceil(median_edge_pixels)), options.min_texels_per_edge,
+                          options.max_texels_per_edge);
+  while (texels > options.min_texels_per_edge && LayoutFor(triangles.size(), texels).LongerSide() > options.max_atlas_size) {
+    --texels;
+  }
+  const AtlasLayout layout = LayoutFor(triangles.size(), texels);
   summary.texels_per_edge = texels;
 
   TriangleMesh mesh;
   mesh.vertices = vertices;
   mesh.triangles = triangles;
-  mesh.atlas = Image(columns * cell, std::max(rows, 1) * cell, 3);
+  mesh.atlas = Image(layout.Width(), layout.Height(), 3);
   mesh.corner_uvs.resize(3 * triangles.size());
   const float width = static_cast<float>(mesh.atlas.Width());
   const float height = static_cast<float>(mesh.atlas.Height());
   for (size_t t = 0; t < triangles.size(); ++t) {
-    const Eigen::Vector2f origin(static_cast<float>(static_cast<int>(t) % columns * cell + 1),
-                                 static_cast<float>(static_cast<int>(t) / columns * cell + 1));
-    // Corner 0 at the inner lower-left, 1 along the row, 2 along the column (image rows run
-    // down; the OBJ v axis runs up).
-    const std::array<Eigen::Vector2f, 3> corners = {origin, origin + Eigen::Vector2f(static_cast<float>(texels), 0),
-                                                    origin + Eigen::Vector2f(0, static_cast<float>(texels))};
-    for (size_t c = 0; c < 3; ++c) {
-      mesh.corner_uvs[3 * t + c] = Eigen::Vector2f(corners[c].x() / width, 1.0f - corners[c].y() / height);
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector2f corner = layout.Corner(t, c);
+      mesh.corner_uvs[3 * t + static_cast<size_t>(c)] = Eigen::Vector2f(corner.x() / width, 1.0f - corner.y() / height);
     }
   }
-  // The surface point each texel of triangle t shows: texels outside the triangle take its
-  // nearest point.
+  // The surface point a texel of triangle t shows, given by its place (i, j) from the
+  // triangle's first corner along its legs: texels outside the triangle take its nearest point.
   const auto texel_point = [&](size_t t, int i, int j) {
     const Eigen::Vector3i& tri = triangles[t];
     const Eigen::Vector3f& v0 = vertices[static_cast<size_t>(tri[0])];
@@ -241,20 +304,6 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
     return Eigen::Vector3f(v0 + a * (vertices[static_cast<size_t>(tri[1])] - v0) +
                            b * (vertices[static_cast<size_t>(tri[2])] - v0));
   };
-  const auto texel_index = [&](size_t t, int i, int j) {
-    const int x = static_cast<int>(t) % columns * cell + i, y = static_cast<int>(t) / columns * cell + j;
-    return static_cast<size_t>(y) * static_cast<size_t>(mesh.atlas.Width()) + static_cast<size_t>(x);
-  };
-  // Which triangles rank each photo, and with what weight (score / best score)^exponent.
-  std::vector<std::vector<std::pair<size_t, float>>> uses(views.size());
-  for (size_t t = 0; t < triangles.size(); ++t) {
-    for (const Candidate& candidate : ranked[t]) {
-      if (candidate.view < 0) break;
-      const double ratio = static_cast<double>(candidate.score / ranked[t][0].score);
-      uses[static_cast<size_t>(candidate.view)].emplace_back(
-          t, static_cast<float>(std::pow(ratio, options.blend_exponent)));
-    }
-  }
   TexelAccumulator texels_sum(mesh.atlas);
   for (size_t v = 0; v < views.size(); ++v) {
     if (uses[v].empty()) continue;
@@ -264,22 +313,24 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
     tbb::parallel_for(tbb::blocked_range<size_t>(0, uses[v].size()), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t u = range.begin(); u < range.end(); ++u) {
         const auto [t, weight] = uses[v][u];
-        for (int j = 0; j < cell; ++j) {
-          for (int i = 0; i < cell; ++i) {
+        const bool second = t % 2 == 1;
+        for (int j = 0; j < layout.CellHeight(); ++j) {
+          for (int i = 0; i < layout.CellWidth(); ++i) {
+            if (layout.OwnedBySecond(i, j) != second) continue;
+            const int along = second ? layout.CellWidth() - 1 - i : i;
+            const int up = second ? layout.CellHeight() - 1 - j : j;
             Eigen::Vector2f pixel;
             float depth = 0;
-            if (!ProjectPinhole(view, texel_point(t, i, j), pixel, depth) || !Inside(view, pixel, -kBorderPixels)) {
+            if (!ProjectPinhole(view, texel_point(t, along, up), pixel, depth) || !Inside(view, pixel, -kBorderPixels)) {
               continue;
             }
-            texels_sum.Add(texel_index(t, i, j), SampleBilinear(color, pixel), weight);
+            texels_sum.Add(layout.TexelIndex(t, i, j), SampleBilinear(color, pixel), weight);
           }
         }
       }
     });
   }
   texels_sum.Finish();
-  summary.untextured_triangles = static_cast<size_t>(
-      std::count_if(ranked.begin(), ranked.end(), [](const Candidates& c) { return c[0].view < 0; }));
   return mesh;
 }
 

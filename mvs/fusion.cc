@@ -193,14 +193,16 @@ using UsedPixels = std::vector<std::vector<bool>>;
 // neighbours' pixels, so a surface that views far apart in the neighbour graph both see would be
 // fused once by each, and the cloud would grow with the number of photos. A new point is merged
 // instead into the nearest point an earlier reference fused that is the same sample of the same
-// surface: facing the same way, within a pixel of it along the surface and within the depth
-// tolerance across it. The cloud's density then follows the surface and the working resolution,
-// not the number of photos, and so do fusion's and the mesh's memory.
+// surface: facing the same way, within the merge spacing of it along the surface and within the
+// depth tolerance across it. The first reference to fuse a surface sets its density, later ones
+// only fill the gaps: the cloud follows the surface and the working resolution, not the number
+// of photos, and so do fusion's and the mesh's memory.
 class FusedCloud {
  public:
   explicit FusedCloud(const FusionOptions& options)
-      : min_normal_cos_(std::cos(options.max_normal_angle_deg * std::numbers::pi / 180)),
-        max_relative_depth_(options.max_relative_depth) {}
+      : min_normal_cos_(std::cos(options.max_merge_normal_angle_deg * std::numbers::pi / 180)),
+        max_relative_depth_(options.max_relative_depth),
+        merge_spacing_(options.merge_spacing_pixels) {}
 
   // The reference's own points are never merged with each other: they are one per pixel.
   void BeginReference() { reference_start_ = points_.size(); }
@@ -214,8 +216,7 @@ class FusedCloud {
       next_in_cell_.push_back(kNone);
       return;
     }
-    const double max_across = std::min(max_relative_depth_ * depth, std::ldexp(1.0, level));
-    if (const std::optional<uint32_t> same = SameSample(point, *cell, footprint, max_across)) {
+    if (const std::optional<uint32_t> same = SameSample(point, level, depth, merge_spacing_ * footprint)) {
       Merge(point, points_[*same]);
       return;
     }
@@ -258,11 +259,23 @@ class FusedCloud {
     return cell;
   }
 
-  // The nearest earlier point in the 27 cells around `cell` that `point` samples again.
-  std::optional<uint32_t> SameSample(const FusedPoint& point, const Cell& cell, double footprint,
-                                     double max_across) const {
+  // The nearest earlier point that `point` samples again, among the 27 cells around it at its
+  // own level and at the next finer one (where a closer view's points lie).
+  std::optional<uint32_t> SameSample(const FusedPoint& point, int level, double depth, double max_along) const {
     std::optional<uint32_t> nearest;
     double nearest_distance = 0;
+    for (const int cell_level : {level, level - 1}) {
+      const std::optional<Cell> cell = CellOf(point.position, cell_level);
+      if (!cell) continue;
+      const double max_across = std::min(max_relative_depth_ * depth, std::ldexp(1.0, cell_level));
+      NearestInCells(point, *cell, max_along, max_across, nearest, nearest_distance);
+    }
+    return nearest;
+  }
+
+  // Updates `nearest` with the points of the 27 cells around `cell` that `point` samples again.
+  void NearestInCells(const FusedPoint& point, const Cell& cell, double max_along, double max_across,
+                      std::optional<uint32_t>& nearest, double& nearest_distance) const {
     for (int dz = -1; dz <= 1; ++dz) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -275,7 +288,7 @@ class FusedCloud {
             const Eigen::Vector3d offset = (point.position - other.position).cast<double>();
             const double across = std::abs(offset.dot(other.normal.cast<double>()));
             const double along = std::sqrt(std::max(0.0, offset.squaredNorm() - across * across));
-            if (across > max_across || along > footprint) continue;
+            if (across > max_across || along > max_along) continue;
             if (!nearest || offset.norm() < nearest_distance) {
               nearest = i;
               nearest_distance = offset.norm();
@@ -284,7 +297,6 @@ class FusedCloud {
         }
       }
     }
-    return nearest;
   }
 
   // `into` becomes the mean of both, each weighted by the pixels it was fused from.
@@ -301,6 +313,7 @@ class FusedCloud {
 
   const double min_normal_cos_;
   const double max_relative_depth_;
+  const double merge_spacing_;
   FusedPoints points_;
   std::deque<uint32_t> next_in_cell_;  // Per point: the next point of its cell, or kNone.
   std::unordered_map<Cell, uint32_t, CellHash> cells_;  // The last point added to each cell.
@@ -372,6 +385,10 @@ void FusionOptions::Check() const {
   RequireOption(max_relative_depth > 0, "FusionOptions.max_relative_depth", max_relative_depth, "> 0");
   RequireOption(max_normal_angle_deg > 0 && max_normal_angle_deg <= 180, "FusionOptions.max_normal_angle_deg",
                 max_normal_angle_deg, "(0, 180]");
+  RequireOption(max_merge_normal_angle_deg > 0 && max_merge_normal_angle_deg <= 180,
+                "FusionOptions.max_merge_normal_angle_deg", max_merge_normal_angle_deg, "(0, 180]");
+  RequireOption(merge_spacing_pixels > 0 && merge_spacing_pixels <= 2, "FusionOptions.merge_spacing_pixels",
+                merge_spacing_pixels, "(0, 2]");
   RequireOption(image_scale >= 0.25 && image_scale <= 1, "FusionOptions.image_scale", image_scale, "[0.25, 1]");
   RequireOption(max_image_size == 0 || max_image_size >= 64, "FusionOptions.max_image_size", max_image_size,
                 "0 (no cap) or >= 64");
@@ -380,7 +397,7 @@ void FusionOptions::Check() const {
 FusedPoints FuseWorkspace(const fs::path& workspace, const FusionOptions& options, Progress& progress) {
   options.Check();
   const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
   const std::vector<const SparseImage*> views = ViewsWithDepth(ws, model);
   const std::vector<std::vector<size_t>> neighbours = Neighbours(model, views, options.max_neighbours);
   FusionViewCache cache(ws, model, views, options);

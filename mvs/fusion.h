@@ -21,6 +21,12 @@ struct FusionOptions {
   double max_relative_depth = 0.01;
   // ... and its normal within this angle (degrees).
   double max_normal_angle_deg = 20;
+  // A point another reference fused is the same sample when it faces the same way, normals
+  // within this angle (looser than the pixels': PatchMatch's normals are noisy; a thin wall's
+  // two sides still stay apart) ...
+  double max_merge_normal_angle_deg = 60;
+  // ... and lies within this many of the fusing pixel's footprints along the surface.
+  double merge_spacing_pixels = 1.5;
   // Each view is merged with the views that share the most sparse points with it, at most
   // this many; only they are in memory with it, so memory does not grow with the photo count.
   int max_neighbours = 8;

@@ -351,7 +351,7 @@ int RunMultiViewStereoBlock(const fs::path& workspace, const MvsOptions& options
                             Progress& progress) {
   options.Check();
   const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
   const DepthPlan plan = PlanDepth(model, options, workspace);
   const bool photometric = block.pass == MvsPass::kPhotometric;
   const std::vector<ViewPlan>& views = photometric ? plan.estimated : plan.written;
@@ -380,7 +380,7 @@ int RunMultiViewStereoBlock(const fs::path& workspace, const MvsOptions& options
 
 MvsSummary FinishMultiViewStereoBlocks(const fs::path& workspace, const MvsOptions& options) {
   const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
+  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
   const DepthPlan plan = PlanDepth(model, options, workspace);
   MvsSummary summary;
   summary.estimated_views = static_cast<int>(plan.estimated.size());

@@ -177,9 +177,11 @@ void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, Sta
   const Workspace& paths = sfm.workspace;
   const DepthRequest depth_request = DepthRequestOf(options);
   std::set<std::pair<int, int>> sizes;
-  const SparseModel model = ReadSparseModel(paths.Sparse());
-  for (const Camera& camera : model.Cameras()) {
-    sizes.emplace(static_cast<int>(camera.width), static_cast<int>(camera.height));
+  {  // Not kept through the dense stages: with hundreds of photos the model is tens of MB.
+    const SparseModel model = ReadSparseModelWithoutKeypoints(paths.Sparse());
+    for (const Camera& camera : model.Cameras()) {
+      sizes.emplace(static_cast<int>(camera.width), static_cast<int>(camera.height));
+    }
   }
   summary.depth_resolution = DescribeDepthResolutions(depth_request, sizes);
   const Stage depth = DepthStage(paths, undistort_key, depth_request, sfm.progress);
