@@ -285,6 +285,26 @@ TEST(SparseModel, BinaryRoundTripIsByteExact) {
   ExpectSameModelFiles(dir, "a", "b", ".bin");
 }
 
+TEST(SparseModel, WithoutKeypointsKeepsCamerasPosesAndTracks) {
+  const TempDir dir;
+  const SparseModel model = MakeModel();
+  WriteSparseModel(model, dir / "model", SparseFormat::kBinary);
+  const SparseModel read = ReadSparseModelWithoutKeypoints(dir / "model");
+  ASSERT_EQ(read.Images().size(), model.Images().size());
+  ASSERT_GT(model.Images()[0].points2d.size(), 0u);
+  for (size_t i = 0; i < model.Images().size(); ++i) {
+    EXPECT_TRUE(read.Images()[i].points2d.empty());
+    EXPECT_EQ(read.Images()[i].name, model.Images()[i].name);
+    EXPECT_EQ(read.Images()[i].cam_from_world.translation, model.Images()[i].cam_from_world.translation);
+  }
+  EXPECT_EQ(read.Cameras().size(), model.Cameras().size());
+  ASSERT_EQ(read.Points3D().size(), model.Points3D().size());
+  for (size_t p = 0; p < model.Points3D().size(); ++p) {
+    EXPECT_EQ(read.Points3D()[p].xyz, model.Points3D()[p].xyz);
+    EXPECT_EQ(read.Points3D()[p].track.size(), model.Points3D()[p].track.size());
+  }
+}
+
 TEST(SparseModel, DetectsTheFormatFromTheFilesPresent) {
   const TempDir dir;
   EXPECT_EQ(DetectSparseFormat(dir / "model"), std::nullopt);

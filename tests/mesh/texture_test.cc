@@ -71,6 +71,11 @@ TEST(Texture, RenderOfTheTexturedMeshReproducesThePhoto) {
   EXPECT_GT(summary.untextured_triangles, 0u);
   EXPECT_LT(summary.untextured_triangles, plane.triangles.size());
   EXPECT_GE(summary.texels_per_edge, 2);
+  // Two triangles to a cell of (t + 5) x (t + 2) texels, where a square of t + 2 held one.
+  const double cell_pair = (summary.texels_per_edge + 5.0) * (summary.texels_per_edge + 2.0);
+  const double texels = static_cast<double>(mesh.atlas.Width()) * mesh.atlas.Height();
+  EXPECT_GE(texels, cell_pair * static_cast<double>(plane.triangles.size()) / 2);
+  EXPECT_LT(texels, 1.05 * cell_pair * static_cast<double>(plane.triangles.size()) / 2);
 
   std::vector<uint8_t> covered;
   const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
