@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
@@ -146,7 +147,13 @@ struct AtlasLayout {
   int Width() const { return columns * CellWidth(); }
   int Height() const { return rows * CellHeight(); }
   int LongerSide() const { return std::max(Width(), Height()); }
-  bool OwnedBySecond(int i, int j) const { return i + j > texels + 2; }
+  // Where texel (i, j) of triangle t's cell lies from t's corner 0 along its two legs, in texels;
+  // none when the texel belongs to the other triangle of the cell.
+  std::optional<Eigen::Vector2i> PlaceOnLegs(size_t t, int i, int j) const {
+    const bool second = t % 2 == 1;
+    if ((i + j > texels + 2) != second) return std::nullopt;
+    return second ? Eigen::Vector2i(CellWidth() - 1 - i, CellHeight() - 1 - j) : Eigen::Vector2i(i, j);
+  }
   // Corner c of triangle t in atlas texels (x right, y down); corner 0 is where its legs meet.
   Eigen::Vector2f Corner(size_t t, int c) const {
     const bool second = t % 2 == 1;
@@ -313,15 +320,14 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
     tbb::parallel_for(tbb::blocked_range<size_t>(0, uses[v].size()), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t u = range.begin(); u < range.end(); ++u) {
         const auto [t, weight] = uses[v][u];
-        const bool second = t % 2 == 1;
         for (int j = 0; j < layout.CellHeight(); ++j) {
           for (int i = 0; i < layout.CellWidth(); ++i) {
-            if (layout.OwnedBySecond(i, j) != second) continue;
-            const int along = second ? layout.CellWidth() - 1 - i : i;
-            const int up = second ? layout.CellHeight() - 1 - j : j;
+            const std::optional<Eigen::Vector2i> place = layout.PlaceOnLegs(t, i, j);
+            if (!place) continue;
             Eigen::Vector2f pixel;
             float depth = 0;
-            if (!ProjectPinhole(view, texel_point(t, along, up), pixel, depth) || !Inside(view, pixel, -kBorderPixels)) {
+            if (!ProjectPinhole(view, texel_point(t, place->x(), place->y()), pixel, depth) ||
+                !Inside(view, pixel, -kBorderPixels)) {
               continue;
             }
             texels_sum.Add(layout.TexelIndex(t, i, j), SampleBilinear(color, pixel), weight);
