@@ -88,6 +88,37 @@ std::string DiskFullReason(const fs::path& path) {
          " KiB free on the file system of " + existing.string() + ")";
 }
 
+void RemoveAll(const fs::path& path) {
+  std::error_code error;
+  fs::remove_all(path, error);
+  if (error) throw BadInputError("cannot remove " + path.string() + ": " + error.message());
+}
+
+void ReplaceFolder(const fs::path& scratch, const fs::path& path) {
+  // Built by appending, as TemporaryPathFor: GCC 12 warns (-Wrestrict) on "." + string.
+  std::string trash_name = ".";
+  trash_name += path.filename().string();
+  trash_name += ".trash";
+  const fs::path trash = path.parent_path() / trash_name;
+  RemoveAll(trash);
+  std::error_code error;
+  const bool had_old = fs::exists(fs::symlink_status(path, error));
+  if (had_old) {
+    fs::rename(path, trash, error);
+    if (error) throw BadInputError("cannot move " + path.string() + " aside: " + error.message());
+  }
+  fs::rename(scratch, path, error);
+  if (error) {
+    const std::string message = "cannot move " + scratch.string() + " to " + path.string() + ": " + error.message();
+    std::error_code restore_error;
+    if (had_old) fs::rename(trash, path, restore_error);
+    throw BadInputError(message);
+  }
+  // Only the old one is left to remove: an interrupted run may remove it too.
+  const TemporaryOutput old(trash);
+  RemoveAll(trash);
+}
+
 std::string ReadFileBytes(const fs::path& path) {
   // A folder opens as a stream but throws on reading (found by fuzzing: an OBJ whose mtllib
   // names a folder).

@@ -1,6 +1,7 @@
 #pragma once
 // Writes that never leave a half-written file under the final name: write to a temporary
-// name beside the target, then rename (atomic within one file system).
+// name beside the target, then rename (atomic within one file system). Folders are built under
+// a scratch name and swapped in the same way (ReplaceFolder).
 #include <filesystem>
 #include <functional>
 #include <string_view>
@@ -21,6 +22,18 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view byt
 // has under 1 MiB left, else "": what a failed write by a library or a tool (whose own
 // message may name only a temporary file, or none) most likely ran into.
 std::string DiskFullReason(const std::filesystem::path& path);
+
+// Removes `path` (a file or a folder with everything in it); nothing to do when it does not
+// exist. Throws BadInputError naming `path` if it cannot be removed.
+void RemoveAll(const std::filesystem::path& path);
+
+// Moves the folder (or file) `scratch` to `path`, replacing what was there, so that the old
+// one is never lost before the new one is in place: the old is renamed aside (a hidden
+// ".<name>.trash" beside it), `scratch` renamed to `path`, then the old removed. Where the
+// second rename fails the old is put back. A trash folder left by a run stopped between the
+// renames is removed first. Throws BadInputError naming the paths if a rename or a removal
+// fails.
+void ReplaceFolder(const std::filesystem::path& scratch, const std::filesystem::path& path);
 
 // Whole file as bytes; throws BadInputError naming the file if it cannot be read.
 std::string ReadFileBytes(const std::filesystem::path& path);

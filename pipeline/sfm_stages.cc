@@ -169,19 +169,6 @@ std::string Join(const std::vector<double>& values) {
   return text.str();
 }
 
-// Removes a folder left by an interrupted stage, or the previous result a stage replaces.
-void RemoveAll(const fs::path& path) {
-  std::error_code error;
-  fs::remove_all(path, error);
-  if (error) throw BadInputError("cannot remove " + path.string() + ": " + error.message());
-}
-
-// Moves `from` to `to`, replacing what was there (directory rename is atomic).
-void Replace(const fs::path& from, const fs::path& to) {
-  RemoveAll(to);
-  fs::rename(from, to);
-}
-
 // The known model rewritten with the ids COLMAP's database gave the photos, so that
 // point_triangulator can match its images and cameras to the features and matches.
 SparseModel AlignKnownModelToDatabase(const SparseModel& known, const PhotoSet& photos,
@@ -467,7 +454,7 @@ Stage PhotosStage(const fs::path& photos_dir, const PhotoSet& photos, const Work
       });
       progress.Update("photos", end, total);
     }
-    Replace(output, workspace.ReadablePhotos());
+    ReplaceFolder(output, workspace.ReadablePhotos());
   };
   return stage;
 }
@@ -742,7 +729,7 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
       RunMapper(sfm, hierarchical ? "hierarchical_mapper" : "mapper", arguments, name,
                 key_photos ? static_cast<int>(keys.size()) : num_images);
     }
-    Replace(models, paths.Models());
+    ReplaceFolder(models, paths.Models());
     WriteSparseModel(LargestModel(ModelDirs(paths)), paths.RawModel(), SparseFormat::kBinary);
     // With key photos, the principal point is refined on their model: the photos registered
     // to it afterwards are not adjusted (an adjustment of them all costs twice the memory and
@@ -809,9 +796,9 @@ Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
                      static_cast<int>(sfm.photos.photos.size()), sfm.progress);
     }
     const Workspace undistorted(output);
-    Replace(undistorted.Images(), paths.Images());
-    Replace(undistorted.Stereo(), paths.Stereo());
-    Replace(undistorted.Sparse(), paths.Sparse());
+    ReplaceFolder(undistorted.Images(), paths.Images());
+    ReplaceFolder(undistorted.Stereo(), paths.Stereo());
+    ReplaceFolder(undistorted.Sparse(), paths.Sparse());
     RemoveAll(output);
   };
   return stage;
