@@ -4,6 +4,7 @@
 
 #include "apps/commands.h"
 #include "apps/terminal_progress.h"
+#include "pipeline/depth_workspace.h"
 #include "pipeline/slurm.h"
 
 namespace parallax {

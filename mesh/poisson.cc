@@ -6,18 +6,10 @@
 #include <string>
 #include <unordered_map>
 
-#include "core/error.h"
 #include "core/hash.h"
-#include "core/color_gains.h"
-#include "core/image.h"
-#include "core/sparse_model.h"
-#include "core/workspace.h"
 #include "core/check.h"
-#include "geometry/ply.h"
-#include "geometry/simplify.h"
 
 namespace parallax {
-namespace fs = std::filesystem;
 namespace {
 
 // Points hashed into cubic cells, for "is there a point within r of here" queries.
@@ -95,56 +87,6 @@ TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius)
   return trimmed;
 }
 
-// The cameras, each photo read (and corrected by its color gain) only when the texture needs it.
-std::vector<TextureView> LoadTextureViews(const fs::path& workspace) {
-  const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
-  const ColorGains gains = ReadWorkspaceColorGains(workspace);
-  std::vector<TextureView> views;
-  for (const SparseImage& image : model.Images()) {
-    TextureView view;
-    view.camera = model.CameraById(image.camera_id);
-    view.cam_from_world = image.cam_from_world;
-    view.load_color = [path = ws.Image(image.name), gain = gains.Of(image.name)] {
-      Image color = SrgbToLinear(ReadImage(path));
-      ApplyGain(gain, color);
-      return color;
-    };
-    views.push_back(std::move(view));
-  }
-  return views;
-}
-
-// The Poisson surface of <ws>/fused.ply, trimmed to where the cloud has data; the count of
-// Poisson's own triangles in `poisson_triangles`. The cloud is only in memory in here.
-TriangleMesh TrimmedPoissonSurface(const Workspace& ws, const Colmap& colmap, const MeshOptions& options,
-                                   Progress& progress, size_t& poisson_triangles) {
-  const fs::path fused = ws.Fused();
-  const std::vector<Eigen::Vector3f> points = ReadPly(fused).vertices;
-  if (points.size() < 100) {
-    throw BadInputError(fused.string() + ": only " + std::to_string(points.size()) +
-                        " fused points, too few to mesh");
-  }
-  const fs::path poisson = ws.PoissonMesh();
-  const fs::path temporary = ws.PoissonMeshScratch();
-  colmap.Run("poisson_mesher",
-             {"--input_path", fused.string(), "--output_path", temporary.string(),
-              "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
-              std::to_string(options.poisson_trim)},
-             ws.Log("mesh"), "mesh", 0, progress);
-  fs::rename(temporary, poisson);
-
-  progress.Update("trim", 0, 1);
-  // colmap's solver now and then writes a NaN vertex: its triangles go, the rest is kept.
-  const TriangleMesh raw = ReadPly(poisson, NonFiniteVertices::kDropTheirTriangles);
-  poisson_triangles = raw.triangles.size();
-  const float cell = OctreeCell(points, options.poisson_depth);
-  const float radius = static_cast<float>(options.max_cells_from_data) * cell;
-  TriangleMesh trimmed = Trim(raw, PointGrid(points, radius), radius);
-  progress.Update("trim", 1, 1);
-  return trimmed;
-}
-
 }  // namespace
 
 void MeshOptions::Check() const {
@@ -162,41 +104,12 @@ MeshOptions MeshOptionsFor(Quality quality) {
   return options;
 }
 
-MeshSummary MeshWorkspace(const fs::path& workspace, const Colmap& colmap,
-                          const MeshOptions& options, Progress& progress) {
-  options.Check();
-  const Workspace ws(workspace);
-  MeshSummary summary;
-  const TriangleMesh trimmed = TrimmedPoissonSurface(ws, colmap, options, progress, summary.poisson_triangles);
-  summary.triangles = trimmed.triangles.size();
-  summary.vertices = trimmed.vertices.size();
-
-  progress.Update("texture", 0, 1);
-  const std::vector<TextureView> views = LoadTextureViews(workspace);
-  {  // The full atlas is freed before the display copy's is made.
-    TextureSummary texture;
-    const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
-    WriteTexturedMesh(ws.MeshDir(), textured);
-    summary.texels_per_edge = texture.texels_per_edge;
-    summary.untextured_triangles = texture.untextured_triangles;
-    summary.atlas_width = textured.atlas.Width();
-    summary.atlas_height = textured.atlas.Height();
-  }
-  progress.Update("texture", 1, 1);
-
-  const fs::path display = ws.DisplayMeshDir();
-  if (trimmed.triangles.size() > options.display_max_triangles) {
-    progress.Update("display mesh", 0, 1);
-    const TriangleMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
-    TextureSummary display_texture;
-    WriteTexturedMesh(display, TextureMesh(simplified.vertices, simplified.triangles, views, options.texture,
-                                           display_texture));
-    summary.display_triangles = simplified.triangles.size();
-    progress.Update("display mesh", 1, 1);
-  } else {
-    fs::remove_all(display);  // A stale one from a larger mesh would be shown instead.
-  }
-  return summary;
+TriangleMesh TrimToData(const TriangleMesh& surface, const std::vector<Eigen::Vector3f>& points,
+                        const MeshOptions& options) {
+  if (points.empty()) throw std::invalid_argument("TrimToData: no points to trim to");
+  const float cell = OctreeCell(points, options.poisson_depth);
+  const float radius = static_cast<float>(options.max_cells_from_data) * cell;
+  return Trim(surface, PointGrid(points, radius), radius);
 }
 
 void to_json(nlohmann::json& json, const MeshSummary& mesh) {

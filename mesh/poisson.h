@@ -1,14 +1,17 @@
 #pragma once
-// The mesh stage of `parallax reconstruct`: fused cloud -> `colmap poisson_mesher` (screened
-// Poisson, watertight) -> trimmed to where the cloud has data -> textured from the photos ->
-// <ws>/mesh/mesh.obj|.mtl|.png, and a simplified copy for display -> <ws>/mesh_display/.
-#include <filesystem>
+// The mesh stage's options and summary, and its own step between Poisson and texture: fused
+// cloud -> screened Poisson surface (watertight) -> trimmed to where the cloud has data
+// (TrimToData) -> textured from the photos (mesh/texture.h), and a simplified copy for
+// display. The stage over a workspace, which runs `colmap poisson_mesher` and writes
+// <ws>/mesh/ and <ws>/mesh_display/, is pipeline/mesh_workspace.h.
+#include <cstddef>
+#include <vector>
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "core/progress.h"
-#include "colmap/runner.h"
 #include "core/quality.h"
+#include "geometry/triangle_mesh.h"
 #include "mesh/texture.h"
 
 namespace parallax {
@@ -49,11 +52,11 @@ struct MeshSummary {
 void to_json(nlohmann::json& json, const MeshSummary& mesh);
 void from_json(const nlohmann::json& json, MeshSummary& mesh);
 
-// Reads <ws>/fused.ply, <ws>/sparse and <ws>/images; writes <ws>/mesh/ and <ws>/mesh_display/
-// (each atomically; the latter only for a mesh over the display budget, else it is removed) and
-// the raw Poisson mesh to <ws>/mesh_poisson.ply. Throws BadInputError for an empty cloud,
-// ToolError if colmap fails.
-MeshSummary MeshWorkspace(const std::filesystem::path& workspace, const Colmap& colmap,
-                          const MeshOptions& options, Progress& progress);
+// `surface` (Poisson's, of the cloud `points` at options.poisson_depth) without the triangles
+// that have a corner farther than options.max_cells_from_data octree cells from every point,
+// and without the vertices no triangle uses; the octree cell is the points' bounding cube over
+// 2^poisson_depth. Non-finite vertices count as far. Throws std::invalid_argument for no points.
+TriangleMesh TrimToData(const TriangleMesh& surface, const std::vector<Eigen::Vector3f>& points,
+                        const MeshOptions& options);
 
 }  // namespace parallax

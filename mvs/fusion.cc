@@ -14,12 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/atomic_file.h"
-#include "core/color_gains.h"
-#include "core/depth_map.h"
 #include "core/error.h"
-#include "core/image.h"
-#include "core/sparse_model.h"
-#include "core/workspace.h"
 #include "core/check.h"
 #include "mvs/working_resolution.h"
 
@@ -59,17 +54,6 @@ Image ResampleArea(const Image& image, int width, int height) {
   return small;
 }
 
-// The model's images that have a depth map and a geometric normal map.
-std::vector<const SparseImage*> ViewsWithDepth(const Workspace& ws, const SparseModel& model) {
-  std::vector<const SparseImage*> views;
-  for (const SparseImage& image : model.Images()) {
-    if (fs::exists(ws.Depth(image.name)) && fs::exists(ws.StereoNormalMap(image.name, StereoPass::kGeometric))) {
-      views.push_back(&image);
-    }
-  }
-  return views;
-}
-
 // For each view, the `max_neighbours` others sharing the most sparse points with it (ties: the
 // earlier), in view order.
 std::vector<std::vector<size_t>> Neighbours(const SparseModel& model, const std::vector<const SparseImage*>& views,
@@ -99,13 +83,13 @@ std::vector<std::vector<size_t>> Neighbours(const SparseModel& model, const std:
   return neighbours;
 }
 
-// The views one reference fuses with, read from disk as needed and kept while they fit:
-// memory is bounded by `capacity` views whatever their number.
+// The views one reference fuses with, loaded as needed and kept while they fit: memory is
+// bounded by `capacity` views whatever their number.
 class FusionViewCache {
  public:
-  FusionViewCache(const Workspace& ws, const SparseModel& model, const std::vector<const SparseImage*>& views,
+  FusionViewCache(const SparseModel& model, const std::vector<const SparseImage*>& views, const LoadFusionView& load,
                   const FusionOptions& options)
-      : ws_(ws), model_(model), views_(views), options_(options), gains_(ReadWorkspaceColorGains(ws.Root())),
+      : model_(model), views_(views), load_(load), options_(options),
         capacity_(static_cast<size_t>(options.max_neighbours) + 1) {}
 
   // Every view of `wanted` resident at once; pointers stay valid until the next call.
@@ -146,9 +130,10 @@ class FusionViewCache {
 
   FusionView Load(const SparseImage& image) const {
     const Camera& camera = model_.CameraById(image.camera_id);
-    const DepthMap depth = ReadDepthExr(ws_.Depth(image.name));
-    const DenseArray normals = ReadColmapArray(ws_.StereoNormalMap(image.name, StereoPass::kGeometric));
-    const Image color = ReadImage(ws_.Image(image.name));
+    const FusionViewMaps maps = load_(image);
+    const DepthMap& depth = maps.depth;
+    const DenseArray& normals = maps.normals;
+    const Image& color = maps.color;
     const int width = depth.Width(), height = depth.Height();
     if (width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height) ||
         normals.width != width || normals.height != height || normals.channels != 3 || color.Width() != width ||
@@ -171,15 +156,14 @@ class FusionViewCache {
       for (size_t c = 0; c < 3; ++c) view.normals.values[c * fine.size() + i] = normals.values[c * fine_pixels + fine[i]];
     }
     view.color = ResampleArea(SrgbToLinear(color), working_width, working_height);
-    ApplyGain(gains_.Of(image.name), view.color);
+    ApplyGain(maps.gain, view.color);
     return view;
   }
 
-  const Workspace& ws_;
   const SparseModel& model_;
   const std::vector<const SparseImage*>& views_;
+  const LoadFusionView& load_;
   const FusionOptions& options_;
-  const ColorGains gains_;
   const size_t capacity_;
   std::map<size_t, Entry> resident_;
   uint64_t tick_ = 0;
@@ -394,13 +378,11 @@ void FusionOptions::Check() const {
                 "0 (no cap) or >= 64");
 }
 
-FusedPoints FuseWorkspace(const fs::path& workspace, const FusionOptions& options, Progress& progress) {
+FusedPoints FuseDepthMaps(const SparseModel& model, const std::vector<const SparseImage*>& views,
+                          const LoadFusionView& load, const FusionOptions& options, Progress& progress) {
   options.Check();
-  const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModelWithoutKeypoints(ws.Sparse());
-  const std::vector<const SparseImage*> views = ViewsWithDepth(ws, model);
   const std::vector<std::vector<size_t>> neighbours = Neighbours(model, views, options.max_neighbours);
-  FusionViewCache cache(ws, model, views, options);
+  FusionViewCache cache(model, views, load, options);
   UsedPixels used(views.size());
   for (size_t i = 0; i < views.size(); ++i) {
     const Camera camera = FusionCamera(model.CameraById(views[i]->camera_id), options);

@@ -1,16 +1,23 @@
 #pragma once
-// Fuses the filtered depth maps of a workspace into one point cloud: each pixel's 3D point is
-// merged with the pixels of the other views that see the same surface (depth within 1%,
-// normals within 20 degrees), and kept when enough views agree.
+// Fuses filtered depth maps into one point cloud: each pixel's 3D point is merged with the
+// pixels of the other views that see the same surface (depth within 1%, normals within 20
+// degrees), and kept when enough views agree. The views are read through a loader as they are
+// needed, so memory is bounded by the scene, not the photo count; the loader over a workspace
+// is pipeline/fusion_workspace.h's.
 #include <array>
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "core/color_gains.h"
+#include "core/depth_map.h"
+#include "core/image.h"
 #include "core/progress.h"
+#include "core/sparse_model.h"
 
 namespace parallax {
 
@@ -49,12 +56,23 @@ struct FusedPoint {
 // would (it then holds the old and the new array, up to three times the points, at once).
 using FusedPoints = std::deque<FusedPoint>;
 
-// Reads <ws>/sparse, <ws>/images, <ws>/depth/<stem>.exr and the geometric normal maps under
-// <ws>/stereo/normal_maps (streamed: at most max_neighbours + 1 views in memory, each at the
-// working resolution), colors
-// corrected by <ws>/color_gains.json when present. Views without a depth map are left out.
-// Deterministic.
-FusedPoints FuseWorkspace(const std::filesystem::path& workspace, const FusionOptions& options, Progress& progress);
+// What fusion reads of one view, each at the photo's size.
+struct FusionViewMaps {
+  DepthMap depth;           // The filtered depth map.
+  DenseArray normals;       // The geometric normal map: camera frame, COLMAP's layout.
+  Image color;              // The photo as read (sRGB).
+  RgbGain gain{1, 1, 1};    // The photo's color gain, applied at the working resolution.
+};
+
+// Reads one view's maps; fusion calls it for a view each time it enters the set in memory.
+using LoadFusionView = std::function<FusionViewMaps(const SparseImage& image)>;
+
+// Fuses `views` (images of `model`, each with a depth and a normal map), streamed: at most
+// max_neighbours + 1 views in memory, each at the working resolution. Neighbours are found from
+// the model's 3D points. Throws BadInputError when a view's maps, photo and camera differ in
+// size (and what `load` throws). Deterministic.
+FusedPoints FuseDepthMaps(const SparseModel& model, const std::vector<const SparseImage*>& views,
+                          const LoadFusionView& load, const FusionOptions& options, Progress& progress);
 
 // Binary little-endian PLY with x y z nx ny nz (float) and red green blue (uchar), written
 // atomically. The format COLMAP's fused.ply uses.

@@ -1,15 +1,20 @@
 #pragma once
-// Multi-view stereo over a workspace: for every view of <ws>/sparse (undistorted PINHOLE),
-// PatchMatch against its selected source views, then the geometric-consistency filter; writes
-// docs/design.md's dense files (COLMAP format under <ws>/stereo, EXR depth + confidence under
-// <ws>/depth).
-#include <filesystem>
+// Multi-view stereo, one view at a time, on cameras and photos in memory: which views get depth
+// (PlanDepth), PatchMatch of one view against its sources at the working resolution
+// (EstimateViewDepth), then the geometric-consistency filter against the sources' estimates and
+// the maps at the photo's size (FilterViewDepth). The depth stage that runs this over a
+// workspace, reads its photos and writes its dense files is pipeline/depth_workspace.h.
+#include <cstdint>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
-#include "core/progress.h"
+#include "core/depth_map.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
 #include "mvs/depth_filter.h"
 #include "mvs/patch_match.h"
 #include "core/quality.h"
@@ -75,32 +80,51 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsViewReport, name, sources, mi
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsSummary, views, skipped, photometric_seconds,
                                                 geometric_seconds)
 
-// Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
-// The same as every block of both passes, then FinishMultiViewStereoBlocks.
-MvsSummary RunMultiViewStereo(const std::filesystem::path& workspace, const MvsOptions& options,
-                              Progress& progress);
-
-// The depth stage in parts that separate processes (cluster jobs, pipeline/slurm.h) can run:
-// block `index` of `size` consecutive views of one pass (size 0: every view). Every
-// photometric block must be done before a geometric block starts, since a view is checked
-// against its sources' estimates.
-enum class MvsPass { kPhotometric, kGeometric };
-struct MvsBlock {
-  MvsPass pass;
-  int index = 0;
-  int size = 0;
+// The views whose depth maps are written (`written`) and those PatchMatch runs on
+// (`estimated`): the written ones plus the sources the geometric filter checks them against.
+struct DepthPlan {
+  std::set<std::string> wanted;     // MvsOptions::only_views; empty: every view.
+  std::vector<ViewPlan> all;        // Every view that can get depth (PlanViews).
+  std::vector<ViewPlan> written;
+  std::vector<ViewPlan> estimated;
 };
 
-// Runs one block. Photometric: PatchMatch, each view's estimate to <ws>/stereo/estimates;
-// geometric: the filter, each view's depth maps, then its report beside the estimates. A view
-// whose estimate (or report) exists is not computed again, so a resubmitted job redoes only
-// what is missing. Returns the number of views in the block (0: past the last one).
-int RunMultiViewStereoBlock(const std::filesystem::path& workspace, const MvsOptions& options,
-                            const MvsBlock& block, Progress& progress);
+// Throws std::invalid_argument for invalid options, BadInputError naming a view of
+// options.only_views that the model lacks. Deterministic.
+DepthPlan PlanDepth(const SparseModel& model, const MvsOptions& options);
 
-// Once every block ran: the summary from the views' reports (seconds left 0), and the
-// estimates removed. Throws BadInputError naming a view whose report is missing.
-MvsSummary FinishMultiViewStereoBlocks(const std::filesystem::path& workspace, const MvsOptions& options);
+// Why each image of the model gets no depth map under `plan` (MvsSummary::skipped).
+std::vector<std::string> SkippedViews(const SparseModel& model, const DepthPlan& plan);
+
+// The camera and pose `image` is estimated with, at the working resolution `options` choose
+// for it; no photo yet (that is WorkingGray's).
+StereoView WorkingStereoView(const SparseModel& model, const SparseImage& image, const MvsOptions& options);
+
+// `photo` (as read, any channel count) in grey, resampled to `camera`'s size, the working one
+// (area averaging, no aliasing).
+GrayImage WorkingGray(const Image& photo, const Camera& camera);
+
+// PatchMatch on `plan`'s reference against its sources within its depth range. `views` holds
+// the reference and every source, each at the working resolution with its photo.
+DepthNormalMap EstimateViewDepth(const ViewPlan& plan, const std::map<uint32_t, StereoView>& views,
+                                 const MvsOptions& options);
+
+// One view's depth after both passes, at the photo's size whatever the working resolution
+// (upsampled nearest, never blending depths across an edge).
+struct ViewDepth {
+  DepthNormalMap estimate;  // The photometric estimate.
+  FilteredDepth filtered;   // What the geometric filter kept, and its confidence.
+  MvsViewReport report;     // Its shares are those of the two maps above.
+};
+
+// The geometric pass for `view`: its photometric estimate `low` (working resolution) checked
+// against its sources' estimates, `source_estimates` by image id (sources without one are left
+// out; with none, nothing is kept). Needs no photos, only cameras and poses.
+ViewDepth FilterViewDepth(const SparseModel& model, const ViewPlan& view, const DepthNormalMap& low,
+                          const std::map<uint32_t, DepthNormalMap>& source_estimates, const MvsOptions& options);
+
+// COLMAP's normal map (3 channels, channel-major) of `map`, 0 where `keep` has no depth.
+DenseArray ColmapNormalMap(const DepthNormalMap& map, const DepthMap& keep);
 
 // Depth at pixel centres (our convention) -> depth sampled at integer image points (x, y), as
 // COLMAP's dense code reads its maps: inverse depth averaged over the four surrounding pixel

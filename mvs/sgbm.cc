@@ -1,21 +1,15 @@
 #include "mvs/sgbm.h"
 
-#include <chrono>
 #include <cmath>
 #include <optional>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "core/depth_map.h"
 #include "core/error.h"
-#include "core/image.h"
-#include "core/sparse_model.h"
-#include "core/workspace.h"
 #include "core/check.h"
 
 namespace parallax {
-namespace fs = std::filesystem;
 namespace {
 
 // OpenCV's pixel centres lie at integers, COLMAP's at integer + 0.5.
@@ -25,8 +19,7 @@ cv::Mat IntrinsicMatrix(const Camera& camera) {
 }
 
 // 8-bit grey version of a photo.
-cv::Mat LoadGray8(const fs::path& path) {
-  const Image image = ReadImage(path);
+cv::Mat Gray8(const Image& image) {
   cv::Mat gray(image.Height(), image.Width(), CV_8U);
   for (int y = 0; y < image.Height(); ++y) {
     for (int x = 0; x < image.Width(); ++x) {
@@ -155,84 +148,85 @@ void SgbmOptions::Check() const {
   RequireOption(speckle_range >= 0, "SgbmOptions.speckle_range", speckle_range, ">= 0");
 }
 
-MvsSummary RunSgbmStereo(const fs::path& workspace, const ViewSelectionOptions& view_options,
-                         const SgbmOptions& options, Progress& progress) {
-  options.Check();
-  view_options.Check();
-  const Workspace ws(workspace);
-  const SparseModel model = ReadSparseModel(ws.Sparse());
-  const std::vector<ViewPlan> plans = PlanViews(model, view_options);
-  MvsSummary summary;
-  summary.estimated_views = static_cast<int>(plans.size());
-  const auto start = std::chrono::steady_clock::now();
-  for (size_t i = 0; i < plans.size(); ++i) {
-    progress.Update("sgbm", static_cast<int64_t>(i), static_cast<int64_t>(plans.size()));
-    const ViewPlan& plan = plans[i];
-    const SparseImage& reference = model.ImageById(plan.image_id);
-    const Camera& camera = model.CameraById(reference.camera_id);
-    std::optional<RectifiedPair> pair;
-    const SparseImage* source = nullptr;
-    for (uint32_t id : plan.sources) {
-      source = &model.ImageById(id);
-      pair = Rectify(camera, reference.cam_from_world, model.CameraById(source->camera_id),
-                     source->cam_from_world);
-      if (pair) break;
-    }
-    if (!pair) {
-      summary.skipped.push_back(plan.name + ": no source view to its right for rectified stereo");
-      continue;
-    }
-    const cv::Size size = pair->size;
-    cv::Mat map_x, map_y, left, right;
-    cv::initUndistortRectifyMap(IntrinsicMatrix(camera), cv::noArray(), pair->r1, pair->p1, size,
-                                CV_32FC1, map_x, map_y);
-    cv::remap(LoadGray8(ws.Image(reference.name)), left, map_x, map_y, cv::INTER_LINEAR);
-    const cv::Size photo_size(static_cast<int>(camera.width), static_cast<int>(camera.height));
-    const cv::Mat matchable = MatchableMask(left, map_x, map_y, photo_size, options.block_size);
-    const Camera& source_camera = model.CameraById(source->camera_id);
-    cv::initUndistortRectifyMap(IntrinsicMatrix(source_camera), cv::noArray(), pair->r2, pair->p2,
-                                size, CV_32FC1, map_x, map_y);
-    cv::remap(LoadGray8(ws.Image(source->name)), right, map_x, map_y, cv::INTER_LINEAR);
+namespace {
 
-    int min_disparity = 0, num_disparities = 16;
-    DisparityRange(*pair, plan.min_depth, plan.max_depth, min_disparity, num_disparities);
-    const int block = options.block_size;
-    cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
-        min_disparity, num_disparities, block, 8 * block * block, 32 * block * block, 1, 0,
-        options.uniqueness_ratio, options.speckle_window, options.speckle_range,
-        cv::StereoSGBM::MODE_SGBM_3WAY);
-    // StereoSGBM leaves the first min + num disparities columns unmatched: pad both images on
-    // the left by that much and crop the padding off the disparities.
-    const int pad = min_disparity + num_disparities;
-    cv::copyMakeBorder(left, left, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
-    cv::copyMakeBorder(right, right, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
-    cv::Mat padded_disparity;
-    sgbm->compute(left, right, padded_disparity);
-    cv::Mat disparity = padded_disparity.colRange(pad, padded_disparity.cols);
-    // StereoSGBM's "no disparity" value.
-    disparity.setTo(cv::Scalar((min_disparity - 1) * 16), ~matchable);
-    const DepthMap depth = DepthFromDisparity(disparity, *pair, camera, min_disparity);
-    DepthMap confidence(depth.Width(), depth.Height());
-    for (size_t p = 0; p < depth.Values().size(); ++p) {
-      confidence.Values()[p] = depth.Values()[p] > 0 ? 1.0f : 0.0f;
+// The first of `plan`'s sources that rectifies to the right of its view, with the
+// rectification; nullopt when none does.
+std::optional<std::pair<const SparseImage*, RectifiedPair>> RightSource(const SparseModel& model, const ViewPlan& plan) {
+  const SparseImage& reference = model.ImageById(plan.image_id);
+  const Camera& camera = model.CameraById(reference.camera_id);
+  for (uint32_t id : plan.sources) {
+    const SparseImage& source = model.ImageById(id);
+    if (std::optional<RectifiedPair> pair =
+            Rectify(camera, reference.cam_from_world, model.CameraById(source.camera_id), source.cam_from_world)) {
+      return std::pair{&source, std::move(*pair)};
     }
-    WriteDepthExr(ws.Depth(plan.name), depth);
-    WriteDepthExr(ws.DepthConfidence(plan.name), confidence);
-    MvsViewReport report;
-    report.name = plan.name;
-    report.sources = {source->name};
-    report.min_depth = plan.min_depth;
-    report.max_depth = plan.max_depth;
-    size_t valid = 0;
-    for (float value : depth.Values()) valid += value > 0;
-    report.geometric_share = report.photometric_share =
-        static_cast<double>(valid) / static_cast<double>(depth.Values().size());
-    summary.views.push_back(std::move(report));
   }
-  progress.Update("sgbm", static_cast<int64_t>(plans.size()), static_cast<int64_t>(plans.size()));
-  summary.photometric_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return summary;
+  return std::nullopt;
+}
+
+// StereoSGBM's disparities of the rectified pair (left: the reference), in 1/16 pixel; its
+// "no disparity" value, (min_disparity - 1) * 16, where a window cannot be trusted.
+cv::Mat MatchPair(const cv::Mat& left_photo, const cv::Mat& right_photo, const Camera& camera,
+                  const Camera& source_camera, const RectifiedPair& pair, int min_disparity, int num_disparities,
+                  const SgbmOptions& options) {
+  const cv::Size size = pair.size;
+  cv::Mat map_x, map_y, left, right;
+  cv::initUndistortRectifyMap(IntrinsicMatrix(camera), cv::noArray(), pair.r1, pair.p1, size, CV_32FC1, map_x,
+                              map_y);
+  cv::remap(left_photo, left, map_x, map_y, cv::INTER_LINEAR);
+  const cv::Size photo_size(static_cast<int>(camera.width), static_cast<int>(camera.height));
+  const cv::Mat matchable = MatchableMask(left, map_x, map_y, photo_size, options.block_size);
+  cv::initUndistortRectifyMap(IntrinsicMatrix(source_camera), cv::noArray(), pair.r2, pair.p2, size, CV_32FC1,
+                              map_x, map_y);
+  cv::remap(right_photo, right, map_x, map_y, cv::INTER_LINEAR);
+  const int block = options.block_size;
+  cv::Ptr<cv::StereoSGBM> sgbm = cv::StereoSGBM::create(
+      min_disparity, num_disparities, block, 8 * block * block, 32 * block * block, 1, 0,
+      options.uniqueness_ratio, options.speckle_window, options.speckle_range,
+      cv::StereoSGBM::MODE_SGBM_3WAY);
+  // StereoSGBM leaves the first min + num disparities columns unmatched: pad both images on
+  // the left by that much and crop the padding off the disparities.
+  const int pad = min_disparity + num_disparities;
+  cv::copyMakeBorder(left, left, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+  cv::copyMakeBorder(right, right, 0, 0, pad, 0, cv::BORDER_CONSTANT, 0);
+  cv::Mat padded_disparity;
+  sgbm->compute(left, right, padded_disparity);
+  cv::Mat disparity = padded_disparity.colRange(pad, padded_disparity.cols);
+  disparity.setTo(cv::Scalar((min_disparity - 1) * 16), ~matchable);
+  return disparity;
+}
+
+}  // namespace
+
+std::optional<SgbmViewDepth> SgbmStereoView(const SparseModel& model, const ViewPlan& plan,
+                                            const std::function<Image(const SparseImage&)>& read_photo,
+                                            const SgbmOptions& options) {
+  const std::optional<std::pair<const SparseImage*, RectifiedPair>> found = RightSource(model, plan);
+  if (!found) return std::nullopt;
+  const auto& [source, pair] = *found;
+  const SparseImage& reference = model.ImageById(plan.image_id);
+  const Camera& camera = model.CameraById(reference.camera_id);
+  int min_disparity = 0, num_disparities = 16;
+  DisparityRange(pair, plan.min_depth, plan.max_depth, min_disparity, num_disparities);
+  const cv::Mat left_photo = Gray8(read_photo(reference));
+  const cv::Mat disparity = MatchPair(left_photo, Gray8(read_photo(*source)), camera,
+                                      model.CameraById(source->camera_id), pair, min_disparity, num_disparities, options);
+  SgbmViewDepth view;
+  view.depth = DepthFromDisparity(disparity, pair, camera, min_disparity);
+  view.confidence = DepthMap(view.depth.Width(), view.depth.Height());
+  for (size_t p = 0; p < view.depth.Values().size(); ++p) {
+    view.confidence.Values()[p] = view.depth.Values()[p] > 0 ? 1.0f : 0.0f;
+  }
+  view.report.name = plan.name;
+  view.report.sources = {source->name};
+  view.report.min_depth = plan.min_depth;
+  view.report.max_depth = plan.max_depth;
+  size_t valid = 0;
+  for (float value : view.depth.Values()) valid += value > 0;
+  view.report.geometric_share = view.report.photometric_share =
+      static_cast<double>(valid) / static_cast<double>(view.depth.Values().size());
+  return view;
 }
 
 }  // namespace parallax

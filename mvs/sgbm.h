@@ -3,11 +3,16 @@
 // matching (StereoSGBM) on rectified pairs. Each view is paired with its nearest source view
 // whose rectified baseline runs horizontally to the right, rectified (cv::stereoRectify),
 // matched, and the disparities are lifted to 3D and projected back into the view's own
-// camera (z-buffer) as a depth map at pixel centres.
-#include <filesystem>
+// camera (z-buffer) as a depth map at pixel centres. Over a workspace:
+// pipeline/depth_workspace.h RunSgbmStereo.
+#include <functional>
+#include <optional>
 
-#include "core/progress.h"
+#include "core/depth_map.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
 #include "mvs/mvs.h"
+#include "mvs/view_selection.h"
 
 namespace parallax {
 
@@ -20,13 +25,20 @@ struct SgbmOptions {
   void Check() const;  // Throws std::invalid_argument naming the field and its value.
 };
 
-// Writes <ws>/depth/<stem>.exr and <stem>.confidence.exr (1 where SGBM found a disparity) for
-// every view with a usable pair (after options.Check()); no normal maps (so fusion leaves SGBM views out). The plans
-// (sources, depth ranges) come from the same view selection as multi-view stereo.
-// Textureless windows (grey-level std below 0.004, PatchMatch's threshold) and windows that
-// straddle the photo's edge get no depth: StereoSGBM alone would claim its minimum disparity
-// all over a constant photo.
-MvsSummary RunSgbmStereo(const std::filesystem::path& workspace, const ViewSelectionOptions& views,
-                         const SgbmOptions& options, Progress& progress);
+struct SgbmViewDepth {
+  DepthMap depth;       // At the photo's size; 0 where SGBM found no disparity.
+  DepthMap confidence;  // 1 where it found one, else 0.
+  MvsViewReport report;  // Its one source; both shares that of `depth`.
+};
+
+// The depth of `plan`'s view (a plan of the same view selection as multi-view stereo) from its
+// first source view that rectifies to its right, or nullopt when none does (then no photo is
+// read). `read_photo` returns an image's photo as read; the view's is read first, then its
+// source's. Textureless windows (grey-level std below 0.004, PatchMatch's threshold) and
+// windows that straddle the photo's edge get no depth: StereoSGBM alone would claim its
+// minimum disparity all over a constant photo. Does not check `options` (SgbmOptions::Check).
+std::optional<SgbmViewDepth> SgbmStereoView(const SparseModel& model, const ViewPlan& plan,
+                                            const std::function<Image(const SparseImage&)>& read_photo,
+                                            const SgbmOptions& options);
 
 }  // namespace parallax

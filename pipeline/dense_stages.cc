@@ -9,9 +9,9 @@
 #include "core/hash.h"
 #include "core/sparse_model.h"
 #include "geometry/ply.h"
-#include "mesh/poisson.h"
-#include "mvs/fusion.h"
-#include "mvs/sgbm.h"
+#include "pipeline/depth_workspace.h"
+#include "pipeline/fusion_workspace.h"
+#include "pipeline/mesh_workspace.h"
 #include "sfm/color_gains.h"
 
 namespace parallax {
@@ -109,10 +109,10 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
   }
   stage.run = [workspace, request, every_view, summary, &progress] {
     const MvsOptions options = MvsOptionsOf(request);
-    const MvsSummary mvs = request.collect_blocks ? FinishMultiViewStereoBlocks(workspace.Root(), options)
+    const MvsSummary mvs = request.collect_blocks ? FinishMultiViewStereoBlocks(workspace, options)
                            : request.stereo == StereoMethod::kSgbm
-                               ? RunSgbmStereo(workspace.Root(), options.views, {}, progress)
-                               : RunMultiViewStereo(workspace.Root(), options, progress);
+                               ? RunSgbmStereo(workspace, options.views, {}, progress)
+                               : RunMultiViewStereo(workspace, options, progress);
     if (every_view) WriteFileAtomically(workspace.DepthViews(), nlohmann::json(mvs).dump(2) + "\n");
     if (summary) *summary = mvs;
   };
@@ -152,7 +152,7 @@ Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const
   options.image_scale = mvs.image_scale;
   options.max_image_size = mvs.max_image_size;
   stage.run = [workspace, options, &progress] {
-    WritePly(workspace.Fused(), FuseWorkspace(workspace.Root(), options, progress));
+    WritePly(workspace.Fused(), FuseWorkspace(workspace, options, progress));
   };
   return stage;
 }
@@ -189,7 +189,7 @@ Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const s
     MeshOptions options = MeshOptionsFor(request.quality);
     // A cloud fused from fewer pixels is less dense where it is complete.
     options.poisson_trim += std::log2(FusedPixelShare(workspace, request));
-    const MeshSummary mesh = MeshWorkspace(workspace.Root(), colmap, options, progress);
+    const MeshSummary mesh = MeshWorkspace(workspace, colmap, options, progress);
     WriteFileAtomically(workspace.MeshSummary(), nlohmann::json(mesh).dump(2) + "\n");
   };
   return stage;

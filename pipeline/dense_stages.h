@@ -25,8 +25,9 @@ struct DepthRequest {
   int max_size = 0;
   // Only these views (image names); empty: every view, and depth/views.json is written.
   std::vector<std::string> views;
-  // The views were estimated in blocks by other processes (RunMultiViewStereoBlock): the
-  // stage only collects them. Not part of the key: the maps are the same.
+  // The views were estimated in blocks by other processes (RunMultiViewStereoBlock,
+  // pipeline/depth_workspace.h): the stage only collects them. Not part of the key: the maps
+  // are the same.
   bool collect_blocks = false;
 };
 

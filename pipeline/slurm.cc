@@ -215,7 +215,7 @@ std::string RunDepthBlockStep(const fs::path& workspace, DepthBlockStep step, co
         throw BadInputError(ws.StereoEstimates().string() + " was not prepared for this model and these options "
                             "(run `parallax depth-block " + workspace.string() + " prepare` after SfM)");
       }
-      const int views = RunMultiViewStereoBlock(ws.Root(), MvsOptionsOf(request), block, progress);
+      const int views = RunMultiViewStereoBlock(ws, MvsOptionsOf(request), block, progress);
       return std::to_string(views) + " view(s) in block " + std::to_string(block.index);
     }
     case DepthBlockStep::kCollect:

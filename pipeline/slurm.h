@@ -1,10 +1,10 @@
 #pragma once
 // `reconstruct --executor slurm`: the request as a chain of Slurm jobs on storage every node
 // shares. SfM runs as one job; the depth stage's photometric and geometric passes as job
-// arrays, each task a block of views (mvs/mvs.h MvsBlock, not one view per task: each task
-// reads the model), the geometric array only after every photometric task succeeded
-// (afterok); then one job collects the depth maps and runs fusion, mesh and texture. Every
-// task writes atomically and skips views already done, so a failed or pre-empted task is
+// arrays, each task a block of views (pipeline/depth_workspace.h MvsBlock, not one view per
+// task: each task reads the model), the geometric array only after every photometric task
+// succeeded (afterok); then one job collects the depth maps and runs fusion, mesh and texture.
+// Every task writes atomically and skips views already done, so a failed or pre-empted task is
 // simply resubmitted. The stage keys are a local run's: a workspace moves freely between the
 // two, and the files are the same.
 #include <filesystem>
@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "core/progress.h"
-#include "mvs/mvs.h"
+#include "pipeline/depth_workspace.h"
 #include "pipeline/reconstruct.h"
 
 namespace parallax {

@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "core/workspace.h"
 #include "mvs/mvs.h"
+#include "pipeline/depth_workspace.h"
 #include "pipeline/reconstruct.h"
 #include "tests/temp_dir.h"
 
@@ -37,12 +38,13 @@ TEST(MvsBlocks, BlocksInAnyOrderAndRerunWriteWhatOneRunWrites) {
   sfm.build_mesh = false;
   const fs::path one_run = dir.Path() / "one_run";
   Reconstruct(kSmall / "images", one_run, sfm, progress);
-  const fs::path blocks = dir.Path() / "blocks";
-  fs::copy(one_run, blocks, fs::copy_options::recursive);
+  const fs::path blocks_dir = dir.Path() / "blocks";
+  fs::copy(one_run, blocks_dir, fs::copy_options::recursive);
+  const Workspace blocks(blocks_dir);
 
   MvsOptions options = MvsOptionsFor(Quality::kFast);
   options.max_image_size = 160;
-  const MvsSummary whole = RunMultiViewStereo(one_run, options, progress);
+  const MvsSummary whole = RunMultiViewStereo(Workspace(one_run), options, progress);
   ASSERT_EQ(whole.views.size(), 12u);
 
   // Blocks of 5: the last photometric block first, the first geometric block twice (a
@@ -52,13 +54,12 @@ TEST(MvsBlocks, BlocksInAnyOrderAndRerunWriteWhatOneRunWrites) {
               index == 2 ? 2 : 5);
   }
   EXPECT_EQ(RunMultiViewStereoBlock(blocks, options, {MvsPass::kPhotometric, 3, 5}, progress), 0);
-  const Workspace workspace(blocks);
   EXPECT_THROW(FinishMultiViewStereoBlocks(blocks, options), BadInputError);
   for (const int index : {0, 0, 1, 2}) {
     RunMultiViewStereoBlock(blocks, options, {MvsPass::kGeometric, index, 5}, progress);
   }
   const MvsSummary merged = FinishMultiViewStereoBlocks(blocks, options);
-  EXPECT_FALSE(fs::exists(workspace.StereoEstimates()));
+  EXPECT_FALSE(fs::exists(blocks.StereoEstimates()));
 
   ASSERT_EQ(merged.views.size(), whole.views.size());
   for (size_t i = 0; i < whole.views.size(); ++i) {
@@ -69,7 +70,7 @@ TEST(MvsBlocks, BlocksInAnyOrderAndRerunWriteWhatOneRunWrites) {
   EXPECT_EQ(merged.skipped, whole.skipped);
   for (const char* folder : {"depth", "stereo"}) {
     const auto expected = FilesUnder(one_run / folder);
-    const auto actual = FilesUnder(blocks / folder);
+    const auto actual = FilesUnder(blocks_dir / folder);
     ASSERT_EQ(actual.size(), expected.size()) << folder;
     for (const auto& [name, bytes] : expected) {
       ASSERT_TRUE(actual.contains(name)) << name;

@@ -20,6 +20,8 @@
 #include "geometry/ply.h"
 #include "eval/register_held_out.h"
 #include "mvs/sgbm.h"
+#include "pipeline/depth_workspace.h"
+#include "pipeline/fusion_workspace.h"
 #include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "eval/depth_evaluation.h"
@@ -204,7 +206,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   FusionOptions half_size;
   half_size.max_image_size = static_cast<int>(std::max(model.Cameras().front().width, model.Cameras().front().height) / 2);
   std::vector<Eigen::Vector3f> coarse_points;
-  for (const FusedPoint& point : FuseWorkspace(workspace.Path(), half_size, progress)) coarse_points.push_back(point.position);
+  for (const FusedPoint& point : FuseWorkspace(Workspace(workspace.Path()), half_size, progress)) coarse_points.push_back(point.position);
   const CloudAccuracy coarse_accuracy = MeasureCloud(coarse_points, truth, scene.Training().depth, {});
   EXPECT_GT(coarse_accuracy.points, ours.points / 6);
   EXPECT_LT(coarse_accuracy.points, ours.points / 3);
@@ -246,7 +248,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // The OpenCV StereoSGBM baseline on the same workspace (it overwrites depth/): it works on
   // rectified pairs of these converging cameras, and PatchMatch beats it.
   const MvsSummary sgbm_run =
-      RunSgbmStereo(workspace.Path(), MvsOptionsFor(Quality::kBalanced).views, {}, progress);
+      RunSgbmStereo(Workspace(workspace.Path()), MvsOptionsFor(Quality::kBalanced).views, {}, progress);
   // Every view gets SGBM depth except, at times, the arc's end camera: whether one of its
   // selected sources lies to its right depends on the triangulated points (COLMAP runs
   // multi-threaded), and without one it is skipped, with that reason.
@@ -264,7 +266,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // Half resolution: the maps keep the photos' size, lose some accuracy, stay unbiased.
   MvsOptions half = MvsOptionsFor(Quality::kBalanced);
   half.image_scale = 0.5;
-  RunMultiViewStereo(workspace.Path(), half, progress);
+  RunMultiViewStereo(Workspace(workspace.Path()), half, progress);
   EXPECT_EQ(ReadDepthExr(Workspace(workspace.Path()).Depth("0000.png")).Width(),
             static_cast<int>(truth.Cameras().front().width));
   const DepthEvaluation coarse =

@@ -22,6 +22,7 @@
 #include "mvs/depth_filter.h"
 #include "mvs/patch_match.h"
 #include "mvs/sgbm.h"
+#include "pipeline/depth_workspace.h"
 #include "tests/temp_dir.h"
 
 namespace parallax {
@@ -356,7 +357,7 @@ DepthMap RunSgbm(const GrayImage& left, const GrayImage& right, double depth) {
   const TempDir workspace;
   WriteStereoWorkspace(workspace.Path(), depth, left, right);
   SilentProgress progress;
-  const MvsSummary summary = RunSgbmStereo(workspace.Path(), {}, {}, progress);
+  const MvsSummary summary = RunSgbmStereo(Workspace(workspace.Path()), {}, {}, progress);
   // "right.png" has no partner to its right and is skipped; the reference is estimated.
   EXPECT_EQ(summary.views.size(), 1u);
   if (summary.views.empty()) return DepthMap(kWidth, kHeight);

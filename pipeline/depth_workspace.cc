@@ -1,0 +1,225 @@
+#include "pipeline/depth_workspace.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/atomic_file.h"
+#include "core/depth_map.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// PlanDepth, its error naming the workspace.
+DepthPlan PlanWorkspaceDepth(const Workspace& ws, const SparseModel& model, const MvsOptions& options) {
+  try {
+    return PlanDepth(model, options);
+  } catch (const BadInputError& error) {
+    throw BadInputError(ws.Root().string() + ": " + error.what());
+  }
+}
+
+// The views a reference needs (itself and its sources) at the working resolution; those
+// `previous` already holds are moved over, not loaded again, so consecutive references share
+// their common sources and no more than one reference's views are in memory.
+std::map<uint32_t, StereoView> LoadStereoViews(const Workspace& ws, const SparseModel& model,
+                                               const ViewPlan& plan, const MvsOptions& options,
+                                               std::map<uint32_t, StereoView>& previous) {
+  std::map<uint32_t, StereoView> views;
+  std::vector<uint32_t> ids = plan.sources;
+  ids.push_back(plan.image_id);
+  for (const uint32_t id : ids) {
+    if (const auto found = previous.find(id); found != previous.end()) {
+      views[id] = std::move(found->second);
+      continue;
+    }
+    const SparseImage& image = model.ImageById(id);
+    StereoView& view = views[id];
+    view = WorkingStereoView(model, image, options);
+    view.image = WorkingGray(ReadImage(ws.Image(image.name)), view.camera);
+  }
+  previous.clear();
+  return views;
+}
+
+// A photometric estimate between the passes: depth, normal (3) and cost planes.
+void WriteEstimate(const fs::path& path, const DepthNormalMap& estimate) {
+  const size_t pixels = estimate.depth.Values().size();
+  DenseArray array{estimate.depth.Width(), estimate.depth.Height(), 5, std::vector<float>(5 * pixels)};
+  for (size_t i = 0; i < pixels; ++i) {
+    array.values[i] = estimate.depth.Values()[i];
+    for (size_t c = 0; c < 3; ++c) array.values[(1 + c) * pixels + i] = estimate.normal[3 * i + c];
+    array.values[4 * pixels + i] = estimate.cost[i];
+  }
+  WriteColmapArray(path, array);
+}
+
+DepthNormalMap ReadEstimate(const fs::path& path) {
+  const DenseArray array = ReadColmapArray(path);
+  if (array.channels != 5) throw BadInputError(path.string() + ": not a depth-stage estimate");
+  const size_t pixels = static_cast<size_t>(array.width) * static_cast<size_t>(array.height);
+  DepthNormalMap estimate{DepthMap(array.width, array.height), std::vector<float>(3 * pixels),
+                          std::vector<float>(pixels)};
+  for (size_t i = 0; i < pixels; ++i) {
+    estimate.depth.Values()[i] = array.values[i];
+    for (size_t c = 0; c < 3; ++c) estimate.normal[3 * i + c] = array.values[(1 + c) * pixels + i];
+    estimate.cost[i] = array.values[4 * pixels + i];
+  }
+  return estimate;
+}
+
+// PatchMatch on each of `plans` whose estimate is not in <ws>/stereo/estimates yet.
+void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const std::vector<ViewPlan>& plans,
+                         const MvsOptions& options, Progress& progress) {
+  std::map<uint32_t, StereoView> views;
+  const auto total = static_cast<int64_t>(plans.size());
+  for (size_t i = 0; i < plans.size(); ++i) {
+    progress.Update("depth", static_cast<int64_t>(i), total);
+    const ViewPlan& plan = plans[i];
+    if (fs::exists(ws.StereoEstimate(plan.name))) continue;
+    views = LoadStereoViews(ws, model, plan, options, views);
+    WriteEstimate(ws.StereoEstimate(plan.name), EstimateViewDepth(plan, views, options));
+  }
+  progress.Update("depth", total, total);
+}
+
+// The view's maps in both formats (COLMAP's under <ws>/stereo, EXR under <ws>/depth).
+void WriteViewDepth(const Workspace& ws, const ViewDepth& view) {
+  const std::string& name = view.report.name;
+  WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kPhotometric), ToColmapSampling(view.estimate.depth));
+  WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kGeometric), ToColmapSampling(view.filtered.depth));
+  WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kPhotometric),
+                   ColmapNormalMap(view.estimate, view.estimate.depth));
+  WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kGeometric),
+                   ColmapNormalMap(view.estimate, view.filtered.depth));
+  WriteDepthExr(ws.Depth(name), view.filtered.depth);
+  WriteDepthExr(ws.DepthConfidence(name), view.filtered.confidence);
+}
+
+// The geometric pass for one view: its estimate checked against those of its sources in
+// `estimated` (read back from <ws>/stereo/estimates), written in both formats.
+MvsViewReport FilterAndWriteView(const Workspace& ws, const SparseModel& model, const ViewPlan& view,
+                                 const std::set<std::string>& estimated, const MvsOptions& options) {
+  std::map<uint32_t, DepthNormalMap> source_estimates;
+  for (const uint32_t id : view.sources) {
+    const std::string& name = model.ImageById(id).name;
+    if (estimated.count(name)) source_estimates[id] = ReadEstimate(ws.StereoEstimate(name));
+  }
+  const DepthNormalMap low = ReadEstimate(ws.StereoEstimate(view.name));
+  const ViewDepth depth = FilterViewDepth(model, view, low, source_estimates, options);
+  WriteViewDepth(ws, depth);
+  return depth.report;
+}
+
+// The views of the geometric block `in_block` whose report is not written yet, filtered and
+// written, each with its report.
+void FilterAndWriteBlock(const Workspace& ws, const SparseModel& model, const DepthPlan& plan,
+                         const std::vector<ViewPlan>& in_block, const MvsOptions& options, Progress& progress) {
+  std::set<std::string> estimated;
+  for (const ViewPlan& view : plan.estimated) estimated.insert(view.name);
+  const auto total = static_cast<int64_t>(in_block.size());
+  for (size_t i = 0; i < in_block.size(); ++i) {
+    progress.Update("filter", static_cast<int64_t>(i), total);
+    const fs::path report = ws.StereoViewReport(in_block[i].name);
+    if (fs::exists(report)) continue;
+    const MvsViewReport written = FilterAndWriteView(ws, model, in_block[i], estimated, options);
+    WriteFileAtomically(report, nlohmann::json(written).dump() + "\n");
+  }
+  progress.Update("filter", total, total);
+}
+
+}  // namespace
+
+MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& options, Progress& progress) {
+  fs::remove_all(workspace.StereoEstimates());
+  auto start = std::chrono::steady_clock::now();
+  RunMultiViewStereoBlock(workspace, options, {MvsPass::kPhotometric}, progress);
+  const double photometric_seconds = Seconds(start);
+  start = std::chrono::steady_clock::now();
+  RunMultiViewStereoBlock(workspace, options, {MvsPass::kGeometric}, progress);
+  MvsSummary summary = FinishMultiViewStereoBlocks(workspace, options);
+  summary.photometric_seconds = photometric_seconds;
+  summary.geometric_seconds = Seconds(start);
+  return summary;
+}
+
+int RunMultiViewStereoBlock(const Workspace& workspace, const MvsOptions& options, const MvsBlock& block,
+                            Progress& progress) {
+  options.Check();
+  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+  const DepthPlan plan = PlanWorkspaceDepth(workspace, model, options);
+  const bool photometric = block.pass == MvsPass::kPhotometric;
+  const std::vector<ViewPlan>& views = photometric ? plan.estimated : plan.written;
+  const size_t size = block.size > 0 ? static_cast<size_t>(block.size) : views.size();
+  const size_t first = std::min(views.size(), static_cast<size_t>(block.index) * size);
+  const std::vector<ViewPlan> in_block(views.begin() + static_cast<std::ptrdiff_t>(first),
+                                       views.begin() + static_cast<std::ptrdiff_t>(std::min(views.size(), first + size)));
+  fs::create_directories(workspace.StereoEstimates());
+  if (photometric) {
+    EstimatePhotometric(workspace, model, in_block, options, progress);
+  } else {
+    FilterAndWriteBlock(workspace, model, plan, in_block, options, progress);
+  }
+  return static_cast<int>(in_block.size());
+}
+
+MvsSummary FinishMultiViewStereoBlocks(const Workspace& workspace, const MvsOptions& options) {
+  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+  const DepthPlan plan = PlanWorkspaceDepth(workspace, model, options);
+  MvsSummary summary;
+  summary.estimated_views = static_cast<int>(plan.estimated.size());
+  summary.skipped = SkippedViews(model, plan);
+  for (const ViewPlan& view : plan.written) {
+    const fs::path report = workspace.StereoViewReport(view.name);
+    if (!fs::exists(report)) {
+      throw BadInputError("the depth of " + view.name + " is not done (no " + report.string() +
+                          "): a geometric block did not run or failed");
+    }
+    summary.views.push_back(nlohmann::json::parse(ReadFileBytes(report)).get<MvsViewReport>());
+  }
+  fs::remove_all(workspace.StereoEstimates());
+  return summary;
+}
+
+MvsSummary RunSgbmStereo(const Workspace& workspace, const ViewSelectionOptions& views, const SgbmOptions& options,
+                         Progress& progress) {
+  options.Check();
+  views.Check();
+  const SparseModel model = ReadSparseModel(workspace.Sparse());
+  const std::vector<ViewPlan> plans = PlanViews(model, views);
+  const auto read_photo = [&workspace](const SparseImage& image) { return ReadImage(workspace.Image(image.name)); };
+  MvsSummary summary;
+  summary.estimated_views = static_cast<int>(plans.size());
+  const auto start = std::chrono::steady_clock::now();
+  const auto total = static_cast<int64_t>(plans.size());
+  for (size_t i = 0; i < plans.size(); ++i) {
+    progress.Update("sgbm", static_cast<int64_t>(i), total);
+    std::optional<SgbmViewDepth> view = SgbmStereoView(model, plans[i], read_photo, options);
+    if (!view) {
+      summary.skipped.push_back(plans[i].name + ": no source view to its right for rectified stereo");
+      continue;
+    }
+    WriteDepthExr(workspace.Depth(plans[i].name), view->depth);
+    WriteDepthExr(workspace.DepthConfidence(plans[i].name), view->confidence);
+    summary.views.push_back(std::move(view->report));
+  }
+  progress.Update("sgbm", total, total);
+  summary.photometric_seconds = Seconds(start);
+  return summary;
+}
+
+}  // namespace parallax

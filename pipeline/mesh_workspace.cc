@@ -1,0 +1,104 @@
+#include "pipeline/mesh_workspace.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/color_gains.h"
+#include "core/error.h"
+#include "core/image.h"
+#include "core/sparse_model.h"
+#include "geometry/obj.h"
+#include "geometry/ply.h"
+#include "geometry/simplify.h"
+
+namespace parallax {
+namespace fs = std::filesystem;
+namespace {
+
+// The cameras, each photo read (and corrected by its color gain) only when the texture needs it.
+std::vector<TextureView> LoadTextureViews(const Workspace& workspace) {
+  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+  const ColorGains gains = ReadWorkspaceColorGains(workspace.Root());
+  std::vector<TextureView> views;
+  for (const SparseImage& image : model.Images()) {
+    TextureView view;
+    view.camera = model.CameraById(image.camera_id);
+    view.cam_from_world = image.cam_from_world;
+    view.load_color = [path = workspace.Image(image.name), gain = gains.Of(image.name)] {
+      Image color = SrgbToLinear(ReadImage(path));
+      ApplyGain(gain, color);
+      return color;
+    };
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+// The Poisson surface of <ws>/fused.ply, trimmed to where the cloud has data; the count of
+// Poisson's own triangles in `poisson_triangles`. The cloud is only in memory in here.
+TriangleMesh TrimmedPoissonSurface(const Workspace& workspace, const Colmap& colmap, const MeshOptions& options,
+                                   Progress& progress, size_t& poisson_triangles) {
+  const fs::path fused = workspace.Fused();
+  const std::vector<Eigen::Vector3f> points = ReadPly(fused).vertices;
+  if (points.size() < 100) {
+    throw BadInputError(fused.string() + ": only " + std::to_string(points.size()) +
+                        " fused points, too few to mesh");
+  }
+  const fs::path poisson = workspace.PoissonMesh();
+  const fs::path temporary = workspace.PoissonMeshScratch();
+  colmap.Run("poisson_mesher",
+             {"--input_path", fused.string(), "--output_path", temporary.string(),
+              "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
+              std::to_string(options.poisson_trim)},
+             workspace.Log("mesh"), "mesh", 0, progress);
+  fs::rename(temporary, poisson);
+
+  progress.Update("trim", 0, 1);
+  // colmap's solver now and then writes a NaN vertex: its triangles go, the rest is kept.
+  const TriangleMesh raw = ReadPly(poisson, NonFiniteVertices::kDropTheirTriangles);
+  poisson_triangles = raw.triangles.size();
+  TriangleMesh trimmed = TrimToData(raw, points, options);
+  progress.Update("trim", 1, 1);
+  return trimmed;
+}
+
+}  // namespace
+
+MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, const MeshOptions& options,
+                          Progress& progress) {
+  options.Check();
+  MeshSummary summary;
+  const TriangleMesh trimmed = TrimmedPoissonSurface(workspace, colmap, options, progress, summary.poisson_triangles);
+  summary.triangles = trimmed.triangles.size();
+  summary.vertices = trimmed.vertices.size();
+
+  progress.Update("texture", 0, 1);
+  const std::vector<TextureView> views = LoadTextureViews(workspace);
+  {  // The full atlas is freed before the display copy's is made.
+    TextureSummary texture;
+    const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
+    WriteTexturedMesh(workspace.MeshDir(), textured);
+    summary.texels_per_edge = texture.texels_per_edge;
+    summary.untextured_triangles = texture.untextured_triangles;
+    summary.atlas_width = textured.atlas.Width();
+    summary.atlas_height = textured.atlas.Height();
+  }
+  progress.Update("texture", 1, 1);
+
+  const fs::path display = workspace.DisplayMeshDir();
+  if (trimmed.triangles.size() > options.display_max_triangles) {
+    progress.Update("display mesh", 0, 1);
+    const TriangleMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
+    TextureSummary display_texture;
+    WriteTexturedMesh(display, TextureMesh(simplified.vertices, simplified.triangles, views, options.texture,
+                                           display_texture));
+    summary.display_triangles = simplified.triangles.size();
+    progress.Update("display mesh", 1, 1);
+  } else {
+    fs::remove_all(display);  // A stale one from a larger mesh would be shown instead.
+  }
+  return summary;
+}
+
+}  // namespace parallax
