@@ -120,8 +120,9 @@ void to_json(nlohmann::json& json, const RequestStage& stage) {
 
 namespace {
 
-std::vector<NamedCamera> TargetCameras(const RenderTargets& cameras, const SourceLibrary& library) {
-  return cameras.path ? CamerasAlongPath(*cameras.path, library.Cameras(), library.Names())
+std::vector<NamedCamera> TargetCameras(const fs::path& input, const RenderTargets& cameras,
+                                       const SourceLibrary& library) {
+  return cameras.path ? CamerasAlongPath(*cameras.path, input, library.Cameras(), library.Names())
                       : CamerasFromModel(cameras.model);
 }
 
@@ -170,7 +171,12 @@ RenderSummary CollectBlocks(const fs::path& out, size_t frames, int block_size) 
 }  // namespace
 
 size_t CountRenderTargets(const fs::path& input, const RenderTargets& targets) {
-  return TargetCameras(targets, SourceLibrary(SourcePathsFor(input))).size();
+  const SourceLibrary library(SourcePathsFor(input));
+  // An orbit around sources has as many frames as it says: counting them reads no mesh or cloud.
+  if (targets.path && targets.path->kind == CameraPath::Kind::kOrbit && !library.Cameras().empty()) {
+    return static_cast<size_t>(targets.path->frames);
+  }
+  return TargetCameras(input, targets, library).size();
 }
 
 RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
@@ -189,7 +195,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   summary.stages.push_back(ColorGainsStep(input, scene_folder, settings.color_gains, lock ? &*lock : nullptr));
   if (!settings.color_gains) source_paths.color_gains.clear();
   SourceLibrary library(source_paths);
-  std::vector<NamedCamera> targets = TargetCameras(cameras, library);
+  std::vector<NamedCamera> targets = TargetCameras(input, cameras, library);
   if (part.step == RenderStep::kFrames) {
     const size_t first = std::min(targets.size(), static_cast<size_t>(part.block) * part.block_size);
     const size_t last = std::min(targets.size(), first + part.block_size);

@@ -3,11 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 #include <sstream>
 #include <utility>
-
-#include <Eigen/Dense>
 
 #include "core/depth_map.h"
 #include "core/error.h"
@@ -15,42 +12,15 @@
 #include "core/image.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
+#include "geometry/obj.h"
+#include "geometry/ply.h"
+#include "geometry/scene_frame.h"
 #include "reproject/forward_warp.h"
 #include "reproject/scene_views.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
 namespace {
-
-// The point nearest to every source's optical axis in the least-squares sense: what the
-// photos look at. Falls back to the mean camera centre when the axes are (nearly) parallel.
-Eigen::Vector3d LookedAtPoint(const std::vector<PosedCamera>& sources) {
-  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d rhs = Eigen::Vector3d::Zero(), mean_centre = Eigen::Vector3d::Zero();
-  for (const PosedCamera& source : sources) {
-    const Eigen::Vector3d centre = CameraCenter(source.cam_from_world);
-    const Eigen::Vector3d axis =
-        source.cam_from_world.rotation.conjugate() * Eigen::Vector3d::UnitZ();
-    const Eigen::Matrix3d off_axis = Eigen::Matrix3d::Identity() - axis * axis.transpose();
-    normal += off_axis;
-    rhs += off_axis * centre;
-    mean_centre += centre;
-  }
-  mean_centre /= static_cast<double>(sources.size());
-  // The normal matrix is symmetric positive semi-definite; eigenvalues come sorted upwards.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(normal);
-  if (eigen.eigenvalues()(0) < 1e-6 * eigen.eigenvalues()(2)) return mean_centre;
-  return normal.ldlt().solve(rhs);
-}
-
-// World direction of the sources' mean image "up" (camera -y).
-Eigen::Vector3d MeanUp(const std::vector<PosedCamera>& sources) {
-  Eigen::Vector3d up = Eigen::Vector3d::Zero();
-  for (const PosedCamera& source : sources) {
-    up += source.cam_from_world.rotation.conjugate() * -Eigen::Vector3d::UnitY();
-  }
-  return up.normalized();
-}
 
 std::string FrameName(const std::string& prefix, int index) {
   char name[32];
@@ -68,29 +38,31 @@ int ParseCount(const std::string& text, const std::string& spec) {
   throw BadInputError("--path " + spec + ": '" + text + "' is not a frame count in 1..100000");
 }
 
-std::vector<NamedCamera> Orbit(int frames, const std::vector<PosedCamera>& sources) {
-  const Eigen::Vector3d centre = LookedAtPoint(sources);
-  const Eigen::Vector3d up = MeanUp(sources);
-  double radius = 0, height = 0;
+// The frame `parallax view` fits to the same workspace (viewer/viewer_scene.h): the mesh's
+// positions and triangles and the cloud's positions, read from the files the viewer reads, and
+// the cameras it shows.
+SceneFrame ReadSceneFrame(const fs::path& root, const std::vector<PosedCamera>& sources) {
+  const Workspace workspace(root);
+  TriangleMesh mesh;
+  std::vector<Eigen::Vector3f> cloud;
+  if (fs::exists(workspace.Mesh())) mesh = ReadTexturedMesh(workspace.Mesh());
+  if (fs::exists(workspace.Fused())) cloud = ReadPly(workspace.Fused()).vertices;
+  std::vector<FrameCamera> cameras;
   for (const PosedCamera& source : sources) {
-    const Eigen::Vector3d offset = CameraCenter(source.cam_from_world) - centre;
-    height += offset.dot(up);
-    radius += (offset - offset.dot(up) * up).norm();
+    if (IsProjectionSupported(source.camera.model)) cameras.push_back({source.camera, source.cam_from_world});
   }
-  height /= static_cast<double>(sources.size());
-  radius /= static_cast<double>(sources.size());
-  const Eigen::Vector3d first = CameraCenter(sources.front().cam_from_world) - centre;
-  Eigen::Vector3d u = first - first.dot(up) * up;
-  if (u.norm() < 1e-9 * (1 + first.norm())) u = up.unitOrthogonal();
-  u.normalize();
-  const Eigen::Vector3d v = up.cross(u);
+  return FitSceneFrame(mesh, cloud, cameras);
+}
+
+// Frame i at azimuth 360 i / N on the DefaultOrbit for the first source's intrinsics: where
+// `parallax view --orbit` stands with that camera's size and field of view.
+std::vector<NamedCamera> OrbitCameras(int frames, const fs::path& root, const std::vector<PosedCamera>& sources) {
+  const SceneFrame frame = ReadSceneFrame(root, sources);
+  const Camera& camera = sources.front().camera;
   std::vector<NamedCamera> cameras;
   for (int i = 0; i < frames; ++i) {
-    const double angle = 2 * std::numbers::pi * i / frames;
-    const Eigen::Vector3d eye =
-        centre + height * up + radius * (std::cos(angle) * u + std::sin(angle) * v);
-    cameras.push_back({FrameName("orbit", i),
-                       {sources.front().camera, LookAt(eye, centre, up)}});
+    const double azimuth_deg = 360.0 * i / frames;
+    cameras.push_back({FrameName("orbit", i), {camera, DefaultOrbitPose(frame, azimuth_deg, std::nullopt, camera)}});
   }
   return cameras;
 }
@@ -172,12 +144,12 @@ CameraPath ParseCameraPath(const std::string& spec) {
   throw BadInputError("--path " + spec + ": expected orbit:N or between:IMAGE_A,IMAGE_B,N");
 }
 
-std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
+std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const fs::path& workspace_or_scene,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names) {
   const std::string spec = path.Spec();
   if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
-  if (path.kind == CameraPath::Kind::kOrbit) return Orbit(path.frames, sources);
+  if (path.kind == CameraPath::Kind::kOrbit) return OrbitCameras(path.frames, workspace_or_scene, sources);
   auto find = [&](const std::string& name) -> const PosedCamera& {
     for (size_t i = 0; i < source_names.size(); ++i) {
       if (source_names[i] == name || fs::path(source_names[i]).stem() == name) return sources[i];

@@ -29,8 +29,12 @@ struct NamedCamera {
 std::vector<NamedCamera> CamerasFromModel(const std::filesystem::path& model_dir);
 
 // A camera path among the sources, with the intrinsics of the first source:
-//   orbit:N          N cameras on a circle around the point the sources look at, at their
-//                    mean height and distance, starting at the first source;
+//   orbit:N          N cameras on the orbit `parallax view --orbit` follows (DefaultOrbit,
+//                    geometry/scene_frame.h, of the frame fitted to the workspace's mesh,
+//                    cloud and cameras): frame i is `view --orbit 360i/N` with the first
+//                    source's size and horizontal field of view. With cameras looking in at a
+//                    point, the circle about it at their median distance and elevation; else
+//                    one around the focus box;
 //   between:A,B,N    N cameras from source image A to B (pose interpolation, both included).
 struct CameraPath {
   enum class Kind { kOrbit, kBetween };
@@ -43,8 +47,12 @@ struct CameraPath {
 // Throws BadInputError for a malformed spec (the message shows the forms above).
 CameraPath ParseCameraPath(const std::string& spec);
 
-// Throws BadInputError when there are no sources or `path` names an unknown image.
+// An orbit reads the frame's geometry from `workspace_or_scene`: mesh/mesh.obj and fused.ply
+// when present (the files `parallax view` shows); without either (a scene folder) the cameras
+// alone make the frame (FitSceneFrame). Throws BadInputError when there are no sources,
+// `path` names an unknown image, or a mesh or cloud file is unreadable.
 std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
+                                          const std::filesystem::path& workspace_or_scene,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names);
 

@@ -1,7 +1,5 @@
 #include "viewer/view_cameras.h"
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 
 #include "core/error.h"
@@ -41,39 +39,10 @@ ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name) {
   return ViewCamera{camera, source.cam_from_world, 0};
 }
 
-Orbit DefaultOrbit(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
-                   const Camera& camera) {
-  if (scene.rig) {
-    // As far as the photos' width of the scene needs with this camera's field of view.
-    const double view_tan = 0.5 * static_cast<double>(camera.width) / camera.FocalX();
-    const double scale = std::clamp(scene.rig->half_width_tan / view_tan, 0.25, 4.0);
-    return Orbit{scene.rig->target, scale * scene.rig->distance, elevation_deg.value_or(scene.rig->elevation_deg)};
-  }
-  Orbit orbit{scene.FocusCentre().cast<double>(), 1, elevation_deg.value_or(30)};
-  // The camera's rotation does not depend on the distance d: a corner at q = R (p - target)
-  // seen from distance d has depth q.z + d and must satisfy f |q.x| / (q.z + d) <= kFill W / 2
-  // (and likewise in y).
-  constexpr double kFill = 0.8;
-  const Eigen::Quaterniond rotation = OrbitPose(orbit.target, scene.up, azimuth_deg, orbit.elevation_deg, 1).rotation;
-  const double half_w = 0.5 * kFill * static_cast<double>(camera.width);
-  const double half_h = 0.5 * kFill * static_cast<double>(camera.height);
-  const double size = std::max(1e-6, static_cast<double>(scene.focus.diagonal().norm()));
-  double distance = 1e-3 * size;
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d q =
-        rotation * (scene.focus.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner)).cast<double>() - orbit.target);
-    distance = std::max({distance, camera.FocalX() * std::abs(q.x()) / half_w - q.z(),
-                         camera.FocalY() * std::abs(q.y()) / half_h - q.z(), 1e-3 * size - q.z()});
-  }
-  orbit.distance = distance;
-  return orbit;
-}
-
 ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
                            int width, int height, double fov_deg) {
   const Camera camera = ViewerCamera(width, height, fov_deg);
-  const Orbit orbit = DefaultOrbit(scene, azimuth_deg, elevation_deg, camera);
-  return ViewCamera{camera, OrbitPose(orbit.target, scene.up, azimuth_deg, orbit.elevation_deg, orbit.distance), 0};
+  return ViewCamera{camera, DefaultOrbitPose(scene, azimuth_deg, elevation_deg, camera), 0};
 }
 
 ViewCamera ScaledSourceViewCamera(const ViewerSource& source, int width, int height) {

@@ -1,10 +1,9 @@
 #pragma once
 // The viewpoints `parallax view` renders from: a source camera of the workspace, or an orbit
-// around the scene's centre with the ground horizontal.
+// around the scene with the ground horizontal (DefaultOrbit and OrbitPose of
+// geometry/scene_frame.h, the orbit `parallax render --path orbit:N` follows too).
 #include <optional>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "viewer/renderer.h"
 #include "viewer/viewer_scene.h"
@@ -19,24 +18,9 @@ ViewCamera SourceViewCamera(const ViewerScene& scene, const std::string& name);
 // empty name. Throws BadInputError, as SourceViewCamera does, when none matches.
 std::optional<int> SourceIndex(const ViewerScene& scene, const std::string& name);
 
-// An orbit about the scene: the point looked at, the distance to it and the elevation above
-// the ground (the azimuth is the caller's).
-struct Orbit {
-  Eigen::Vector3d target = Eigen::Vector3d::Zero();
-  double distance = 1;       // Scene units.
-  double elevation_deg = 30;
-};
-
-// The orbit that shows the scene as its photos do: with a camera rig (ViewerScene::rig), the
-// rig's target and (unless `elevation_deg` is given) elevation, at the rig's distance scaled
-// so `camera` sees as wide a slice of the scene as the photos (x0.25..4). Without one, the
-// focus box's centre, `elevation_deg` or 30, and the distance at which the focus box's
-// corners fill 80% of `camera`'s view from `azimuth_deg`.
-Orbit DefaultOrbit(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
-                   const Camera& camera);
-
-// A camera of `width` x `height` (horizontal field of view `fov_deg`) on the DefaultOrbit at
-// `azimuth_deg`, looking at its target with the ground horizontal.
+// A camera of `width` x `height` (horizontal field of view `fov_deg`, ViewerCamera) on the
+// DefaultOrbit at `azimuth_deg` (DefaultOrbitPose), looking at its target with the ground
+// horizontal.
 ViewCamera OrbitViewCamera(const ViewerScene& scene, double azimuth_deg, std::optional<double> elevation_deg,
                            int width, int height, double fov_deg = 50);
 

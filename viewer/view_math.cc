@@ -16,14 +16,6 @@ Eigen::Vector2d NdcZRange(DepthRange range) {
   return range == DepthRange::kZeroToOne ? Eigen::Vector2d(0, 1) : Eigen::Vector2d(-1, 1);
 }
 
-// Two unit axes spanning the plane normal to `up`, the first as close to world x as possible.
-std::pair<Eigen::Vector3d, Eigen::Vector3d> GroundAxes(const Eigen::Vector3d& up) {
-  const Eigen::Vector3d reference =
-      std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d u = (reference - up * up.dot(reference)).normalized();
-  return {u, up.cross(u)};
-}
-
 // A camera frame looking along `forward`, any roll.
 Rigid3d LookAlong(const Eigen::Vector3d& eye, const Eigen::Vector3d& forward) {
   const Eigen::Vector3d up =
@@ -177,17 +169,6 @@ Camera ViewerCamera(int width, int height, double fov_deg) {
   const double focal = 0.5 * width / std::tan(0.5 * Radians(fov_deg));
   return MakePinholeCamera(1, static_cast<uint64_t>(width), static_cast<uint64_t>(height), focal,
                            focal, 0.5 * width, 0.5 * height);
-}
-
-Rigid3d OrbitPose(const Eigen::Vector3d& centre, const Eigen::Vector3d& up, double azimuth_deg,
-                  double elevation_deg, double distance) {
-  const auto [u, v] = GroundAxes(up);
-  // Keep clear of the poles, where LookAt's "up" is parallel to the view.
-  const double elevation = Radians(std::clamp(elevation_deg, -89.0, 89.0));
-  const double azimuth = Radians(azimuth_deg);
-  const Eigen::Vector3d offset =
-      std::cos(elevation) * (std::cos(azimuth) * u + std::sin(azimuth) * v) + std::sin(elevation) * up;
-  return LookAt(centre + distance * offset, centre, up);
 }
 
 Eigen::Vector3d LightDirectionFromAngles(const Eigen::Vector3d& up, double azimuth_deg,

@@ -1,6 +1,7 @@
 #pragma once
 // The matrices of the viewer, pure functions: camera and light projections in OpenGL clip
-// space, the light frustum fitted to the scene, the planar shadow matrix, orbit cameras.
+// space, the light frustum fitted to the scene, the planar shadow matrix. (Orbit cameras:
+// OrbitPose in geometry/scene_frame.h.)
 //
 // Conventions: world points are transformed by cam_from_world into the COLMAP camera frame
 // (x right, y down, z forward); the projections below map that frame to clip space with NDC y
@@ -14,6 +15,7 @@
 #include "core/camera.h"
 #include "core/pose.h"
 #include "geometry/ground_plane.h"
+#include "geometry/scene_frame.h"
 
 namespace parallax {
 
@@ -62,13 +64,8 @@ Eigen::Matrix4f PlanarShadowMatrix(const GroundPlane& plane, const Eigen::Vector
 // A pinhole camera of `width` x `height` with horizontal field of view `fov_deg`.
 Camera ViewerCamera(int width, int height, double fov_deg);
 
-// A camera on a circle around `centre`: azimuth about `up` (0 along the up-perpendicular axis
-// closest to world x), elevation above the plane normal to `up`, at `distance`.
-Rigid3d OrbitPose(const Eigen::Vector3d& centre, const Eigen::Vector3d& up, double azimuth_deg,
-                  double elevation_deg, double distance);
-
 // Unit direction a directional light travels, from azimuth/elevation of the light above the
-// ground (about `up`, as OrbitPose).
+// ground (about `up`, as OrbitPose of geometry/scene_frame.h).
 Eigen::Vector3d LightDirectionFromAngles(const Eigen::Vector3d& up, double azimuth_deg,
                                          double elevation_deg);
 

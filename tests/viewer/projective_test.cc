@@ -198,7 +198,7 @@ TEST(ViewerScene, OrbitLooksWhereTheSourceCamerasLookFromAsFar) {
     walk.push_back(scene.sources[0]);
     walk.back().cam_from_world = LookAt(Eigen::Vector3d(i, 0, 1), Eigen::Vector3d(i + 5, 0, 1), Eigen::Vector3d::UnitZ());
   }
-  EXPECT_FALSE(FitCameraRig(walk, Eigen::Vector3d::UnitZ(), scene.extent).has_value());
+  EXPECT_FALSE(FitCameraRig(FrameCameras(walk), Eigen::Vector3d::UnitZ(), scene.extent).has_value());
 }
 
 // Looking through a source camera: its own frustum and those next to it are not drawn, so the
