@@ -1,7 +1,8 @@
 #pragma once
 // The structure-from-motion stages of `reconstruct` as data (pipeline/stage_graph.h):
 // features, matches, mapper (or triangulate, with known cameras) and undistort, each keyed by
-// the one before it.
+// the one before it. Their decisions are pipeline/sfm_policy.h's; the colmap commands on the
+// mapper's models are colmap/raw_model.h's.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -11,34 +12,11 @@
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "pipeline/reconstruct.h"
+#include "pipeline/sfm_policy.h"
 #include "pipeline/stage_graph.h"
 #include "sfm/photo_set.h"
 
 namespace parallax {
-
-// Which photos share one camera (one set of intrinsics) in COLMAP's database.
-enum class CameraSharing {
-  kAll,       // One camera for every photo.
-  kPerGroup,  // One camera per PhotoSet::CameraGroups group: per size and EXIF camera.
-  kPerPhoto,  // One camera each (a known model with a camera per image).
-};
-
-// The COLMAP image model the extractor starts from, and its parameters when they are fixed.
-struct CameraSetup {
-  CameraModel model;
-  std::string params;  // Empty: COLMAP estimates them, from EXIF or the image size.
-  CameraSharing sharing;
-  bool fixed_intrinsics;
-};
-
-// report.json's words for the camera setup, e.g. "SIMPLE_RADIAL, one shared camera".
-std::string DescribeCameraSetup(const CameraSetup& camera, const PhotoSet& photos);
-
-// The camera model and intrinsics SfM starts from: the known model's, the given intrinsics
-// (fixed), or `options.camera_model` estimated. Throws BadInputError for --intrinsics f on
-// photos of different sizes.
-CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
-                              const SparseModel* known);
 
 // The folder COLMAP and the undistortion read the photos from: the user's, or the
 // workspace's copy with the converted photos when some need it (PhotosStage).
@@ -50,8 +28,6 @@ std::filesystem::path ReadablePhotosDir(const std::filesystem::path& photos_dir,
 // every photo is readable as it is.
 Stage PhotosStage(const std::filesystem::path& photos_dir, const PhotoSet& photos,
                   const Workspace& workspace, Progress& progress);
-// The sentence report.json notes for the conversions, or "" when there were none.
-std::string DescribeConversions(const PhotoSet& photos, const Workspace& workspace);
 
 // What every SfM stage reads.
 struct SfmContext {
@@ -65,20 +41,6 @@ struct SfmContext {
   // MatcherFor: kAuto only past the exhaustive limit, where the capture's order decides.
   MatcherChoice matcher;
   Progress& progress;
-};
-
-// The matcher for `num_images` photos: the user's choice, exhaustive for an automatic choice
-// up to the limit, and kAuto past it (sequential or retrieval, decided in the matches stage).
-MatcherChoice MatcherFor(const ReconstructOptions& options, int num_images);
-// What report.json says of the matcher before matching (a dry run's plan); the matches stage
-// writes what it did into Workspace::MatchedMarker.
-std::string PlannedMatcher(const ReconstructOptions& options, int num_images);
-
-// How the model is mapped: the user's choice, or the automatic one and why.
-struct MapperPlan {
-  MapperChoice mapper = MapperChoice::kIncremental;  // Never kAuto.
-  std::vector<std::string> key_photos;                // kKeyPhotos: in name order.
-  std::string description;                            // report.json's sentence.
 };
 
 // The plan for the photos of `sfm`. Key photos are chosen from the verified matches, so they
