@@ -47,7 +47,7 @@ struct MvsOptions {
 
 // fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
 // balanced: 5 sources, 4x4 samples, 3 iterations, near and far neighbours;
-// best: 7 sources, 4 iterations. Long side capped at kMaxImageSize (docs/depth.md).
+// best: 7 sources, 4 iterations. Long side capped at MaxImageSizeFor(quality) (docs/depth.md).
 MvsOptions MvsOptionsFor(Quality quality);
 
 // The working resolution's long-side cap at each quality (MvsOptions::max_image_size).

@@ -89,7 +89,7 @@ struct ReconstructOptions {
   // image size from the centre; further off it was not observable and drifted.
   double max_refined_principal_point_offset = 0.05;
   PlausibilityOptions plausibility;
-  // Run multi-view stereo after SfM (pipeline/mvs.h), at `quality`.
+  // Run multi-view stereo after SfM (the depth stage, pipeline/dense_stages.h), at `quality`.
   bool estimate_depth = true;
   // Depth-stage method: parallax's PatchMatch, or OpenCV's StereoSGBM on rectified pairs (the
   // baseline the bench compares with).
@@ -101,7 +101,7 @@ struct ReconstructOptions {
   // At most one of the two is set.
   double mvs_scale = 0;
   int mvs_max_size = 0;
-  // After depth: Poisson mesh, trimmed and textured (pipeline/mesh.h).
+  // After depth: Poisson mesh, trimmed and textured (the mesh stage, pipeline/dense_stages.h).
   bool build_mesh = true;
   void Check() const;  // Throws std::invalid_argument naming the field.
 };

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,7 +22,6 @@
 namespace parallax {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxDirections = 16;
 
 bool ShouldFill(PixelClass c, const FillOptions& options) {
@@ -313,7 +313,7 @@ class DepthAwareFiller {
     steps_.resize(static_cast<size_t>(count_) * static_cast<size_t>(max_steps_));
     step_counts_.assign(static_cast<size_t>(count_), 0);
     for (int k = 0; k < count_; ++k) {
-      const double angle = 2 * kPi * k / count_;
+      const double angle = 2 * std::numbers::pi * k / count_;
       const auto dx = static_cast<float>(std::cos(angle)), dy = static_cast<float>(std::sin(angle));
       Step* steps = &steps_[static_cast<size_t>(k) * static_cast<size_t>(max_steps_)];
       int& count = step_counts_[static_cast<size_t>(k)];

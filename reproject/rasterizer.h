@@ -1,7 +1,7 @@
 #pragma once
-// The rasteriser behind ForwardWarp (internal to reproject/: included by forward_warp.cc
-// only): triangles, textured blocks and splats of one source written into its WarpBuffer
-// with a z-test.
+// The rasteriser behind ForwardWarp (internal to reproject/: included by forward_warp.cc and
+// warp_rows.cc only): triangles, textured blocks and splats of one source written into its
+// WarpBuffer with a z-test.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

@@ -1,8 +1,9 @@
 #include "reproject/source_selection.h"
 
 #include <algorithm>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -13,8 +14,6 @@
 
 namespace parallax {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Eigen::Vector3d ViewDirection(const Rigid3d& cam_from_world) {
   return cam_from_world.rotation.inverse() * Eigen::Vector3d::UnitZ();
@@ -53,7 +52,7 @@ std::optional<double> SeenAngleDeg(const Pinhole& source, const Eigen::Vector3d&
   const double u = source.fx * p.x() / p.z() + source.cx, v = source.fy * p.y() / p.z() + source.cy;
   if (!(u >= 0 && v >= 0 && u <= source.width && v <= source.height)) return std::nullopt;
   const double cos_angle = p.normalized().dot((p - target_center).normalized());
-  return std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / kPi;
+  return std::acos(std::clamp(cos_angle, -1.0, 1.0)) * 180.0 / std::numbers::pi;
 }
 
 // How well a source sees a point from `angle_deg` off the target's ray: 1 / (1 + angle /
@@ -161,7 +160,7 @@ std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const Po
   const size_t samples = views.empty() ? 0 : views.front().seen.size();
   // Per sample, how much of it the chosen sources already see from each direction: the
   // largest similarity exp(-(angle / diversity_angle)^2) to the chosen sources' rays.
-  const double sigma_rad = options.diversity_angle_deg * kPi / 180;
+  const double sigma_rad = options.diversity_angle_deg * std::numbers::pi / 180;
   std::vector<int> chosen;
   while (static_cast<int>(chosen.size()) < options.num_sources && !candidates.empty()) {
     double best_gain = -1;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "reproject/rasterizer.h"
 #include "reproject/simd.h"
@@ -9,7 +10,6 @@
 namespace parallax::warp_internal {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 // The per-row constants of ProjectSpan.
 struct RowProjection {
@@ -80,7 +80,7 @@ WarpSetup MakeSetup(const SourceView& source, const PosedCamera& target,
     setup.t[i] = static_cast<float>(target_from_source.translation(i));
   }
   setup.min_view_cos = static_cast<float>(options.min_view_cos);
-  const double slope = std::tan(options.max_slant_deg * kPi / 180.0);
+  const double slope = std::tan(options.max_slant_deg * std::numbers::pi / 180.0);
   setup.max_depth_ratio = static_cast<float>(
       1.0 + slope * std::sqrt(2.0) / std::min(setup.src.fx, setup.src.fy));
   return setup;
