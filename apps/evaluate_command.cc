@@ -157,7 +157,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
     PrintCloudAndMesh(evaluation);
     if (evaluation.novel) PrintNovel(*evaluation.novel);
     const std::filesystem::path out =
-        arguments->json.empty() ? workspace.EvaluationJson() : arguments->json;
+        arguments->json.empty() ? EvaluationLayout(workspace.Root()).Json() : arguments->json;
     WriteFileAtomically(out, nlohmann::json(evaluation).dump(2) + "\n");
     std::printf("json: %s\n", out.string().c_str());
   });

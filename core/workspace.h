@@ -81,16 +81,6 @@ class Workspace {
   std::filesystem::path UndistortScratch() const { return root_ / ".undistort.tmp"; }
   std::filesystem::path WriteProbe() const { return root_ / ".parallax_write_test"; }
 
-  // What `evaluate` writes.
-  std::filesystem::path EvaluationJson() const { return root_ / "evaluation.json"; }
-  std::filesystem::path EvaluationDir() const { return root_ / "evaluation"; }
-  std::filesystem::path DepthErrorImages() const { return EvaluationDir() / "depth_error"; }
-  std::filesystem::path MeshRenders() const { return EvaluationDir() / "mesh_render"; }
-  std::filesystem::path NovelRegistration() const { return EvaluationDir() / "novel_registration"; }
-  std::filesystem::path NovelComparisons(bool ground_truth_sources) const {
-    return EvaluationDir() / (ground_truth_sources ? "novel_gt_sources" : "novel");
-  }
-
  private:
   std::filesystem::path root_;
 };

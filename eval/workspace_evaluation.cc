@@ -46,7 +46,7 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
   if (truth_depth) {
     result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
   }
-  result.render_dir = workspace.MeshRenders();
+  result.render_dir = EvaluationLayout(workspace.Root()).MeshRenders();
   result.texture = ScoreTexturedMesh(mesh, estimate, ReadWorkspaceColorGains(workspace.Root()), workspace.Images(),
                                      result.render_dir);
   return result;
@@ -74,7 +74,7 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
   evaluation.poses = options.gt_sources ? "ground truth" : "aligned";
   if (!options.gt_sources && options.novel_poses == NovelPoses::kRegistered) {
     const HeldOutRegistration registration = RegisterHeldOutPhotos(
-        workspace.Root(), scene.Novel().images, names, workspace.NovelRegistration(), progress);
+        workspace.Root(), scene.Novel().images, names, EvaluationLayout(workspace.Root()).NovelRegistration(), progress);
     for (size_t i = 0; i < names.size(); ++i) {
       const auto found = registration.cam_from_world.find(names[i]);
       if (found == registration.cam_from_world.end()) continue;
@@ -96,7 +96,7 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
   if (!options.gt_sources) {
     evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
   }
-  evaluation.comparison_dir = workspace.NovelComparisons(options.gt_sources);
+  evaluation.comparison_dir = EvaluationLayout(workspace.Root()).NovelComparisons(options.gt_sources);
   evaluation.result = EvaluateNovelViews(library, targets, names, scene.Novel(),
                                          options.novel.selection, options.novel.render,
                                          evaluation.comparison_dir);
@@ -131,7 +131,7 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
   }
   if (has_depth && truth_depth && !options.novel_only) {
     evaluation.depth_aligned = options.align;
-    evaluation.depth_error_dir = workspace.DepthErrorImages();
+    evaluation.depth_error_dir = EvaluationLayout(workspace.Root()).DepthErrorImages();
     DepthEvaluation depth = EvaluateDepth(estimate, workspace.DepthDir(), truth, scene.Training().depth,
                                           truth_from_estimate, evaluation.depth_error_dir);
     if (depth.views > 0) {

@@ -15,6 +15,7 @@
 #include "core/workspace.h"
 #include "eval/cloud_evaluation.h"
 #include "eval/depth_evaluation.h"
+#include "eval/evaluation_layout.h"
 #include "eval/evaluate.h"
 #include "eval/mesh_evaluation.h"
 #include "eval/novel_evaluation.h"
@@ -76,7 +77,7 @@ struct WorkspaceEvaluation {
 };
 
 // Evaluates every part `workspace` has against `scene`, writing the comparison images under
-// workspace.EvaluationDir(). Throws BadInputError when the workspace has no model or a
+// EvaluationLayout(workspace.Root()).Dir(). Throws BadInputError when the workspace has no model or a
 // ground-truth file cannot be read, ToolError when colmap fails to register held-out photos.
 WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFolder& scene,
                                       const EvaluateOptions& options, Progress& progress);

@@ -20,7 +20,6 @@ TEST(Workspace, NamesEveryFileOfTheLayout) {
   EXPECT_EQ(ws.DisplayMesh(), "/w/mesh_display/mesh.obj");
   EXPECT_EQ(ws.Database(), "/w/sfm/database.db");
   EXPECT_EQ(ws.Log("mapper"), "/w/logs/mapper.log");
-  EXPECT_EQ(ws.NovelComparisons(true), "/w/evaluation/novel_gt_sources");
 }
 
 }  // namespace
