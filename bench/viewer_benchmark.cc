@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "tests/viewer/viewer_test_util.h"
+#include "testing/viewer_scenes.h"
 #include "viewer/view_cameras.h"
 
 namespace parallax {

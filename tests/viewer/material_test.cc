@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/viewer/viewer_test_util.h"
+#include "testing/viewer_scenes.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 

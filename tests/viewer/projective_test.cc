@@ -9,7 +9,7 @@
 #include "core/error.h"
 #include "core/sparse_model.h"
 #include "tests/temp_dir.h"
-#include "tests/viewer/viewer_test_util.h"
+#include "testing/viewer_scenes.h"
 #include "geometry/robust_bounds.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tests/viewer/viewer_test_util.h"
+#include "testing/viewer_scenes.h"
 #include "viewer/view_cameras.h"
 #include "viewer/shadow_volume.h"
 #include "viewer/view_math.h"

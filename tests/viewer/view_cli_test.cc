@@ -14,7 +14,7 @@
 #include "core/workspace.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
-#include "tests/viewer/viewer_test_util.h"
+#include "testing/viewer_scenes.h"
 
 namespace parallax {
 namespace {

@@ -1,6 +1,7 @@
 #pragma once
-// Shared by the viewer tests: one headless GL context per process, synthetic scenes built from
-// synth's shapes, and the ray-traced reference shadow mask.
+// Shared by the viewer tests and the viewer benchmark (parallax::viewer_testing): one headless
+// GL context per process, synthetic scenes built from synth's shapes, and the ray-traced
+// reference shadow mask.
 #include <cmath>
 #include <memory>
 #include <optional>
