@@ -1,5 +1,7 @@
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <string>
 #include <memory>
 
 #include "apps/commands.h"
@@ -11,6 +13,7 @@ void RegisterBenchCommand(CLI::App& app) {
   struct Arguments {
     std::filesystem::path scene;
     std::filesystem::path out;
+    BenchGrid grid = BenchGrid::kFull;
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
@@ -23,8 +26,16 @@ void RegisterBenchCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingDirectory);
   command->add_option("out_dir", arguments->out, "where the workspaces and the report go")->required();
+  command
+      ->add_option("--grid", arguments->grid,
+                   "full: every setting of every knob; smoke: each stage and baseline with the few "
+                   "settings the test suite compares (a quick check that the bench works)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, BenchGrid>{{"full", BenchGrid::kFull},
+                                                                           {"smoke", BenchGrid::kSmoke}},
+                                          CLI::ignore_case))
+      ->default_str("full");
   command->callback([arguments] {
-    const BenchSummary summary = RunBench(arguments->scene, arguments->out);
+    const BenchSummary summary = RunBench(arguments->scene, arguments->out, arguments->grid);
     std::printf("bench: %zu runs in %.0f s -> %s (report.md, bench.csv, error_vs_time.png)\n",
                 summary.runs, summary.seconds, arguments->out.string().c_str());
   });

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -31,7 +32,8 @@ struct ChildRun {
 
 class Bench {
  public:
-  Bench(fs::path scene, fs::path out) : scene_{std::move(scene)}, out_(std::move(out)) {
+  Bench(fs::path scene, fs::path out, BenchGrid grid)
+      : scene_{std::move(scene)}, out_(std::move(out)), grid_(grid) {
     self_ = fs::read_symlink("/proc/self/exe").string();
     real_ = !fs::is_directory(scene_.Training().depth);
     fs::create_directories(out_ / "logs");
@@ -85,6 +87,7 @@ class Bench {
   const fs::path& Out() const { return out_; }
   // Real photos: ground-truth cameras and held-out photos, no ground-truth depth.
   bool Real() const { return real_; }
+  bool Smoke() const { return grid_ == BenchGrid::kSmoke; }
   std::vector<BenchRow> rows;
   std::vector<std::string> leave_out;
 
@@ -95,6 +98,7 @@ class Bench {
   SceneFolder scene_;
   fs::path out_;
   std::string self_;
+  BenchGrid grid_;
   bool real_ = false;
 };
 
@@ -113,7 +117,9 @@ double At(const nlohmann::json& json, const std::string& section, const std::str
 }
 
 void Bench::StructureFromMotion() {
-  for (const std::string quality : {"fast", "balanced"}) {
+  const std::vector<std::string> qualities =
+      Smoke() ? std::vector<std::string>{"fast"} : std::vector<std::string>{"fast", "balanced"};
+  for (const std::string& quality : qualities) {
     const fs::path workspace = out_ / ("sfm_" + quality);
     fs::remove_all(workspace);
     const ChildRun run = Parallax("sfm_" + quality, {"reconstruct", Images().string(), workspace.string(),
@@ -176,8 +182,11 @@ void Bench::Depth() {
   const SparseModel truth = ReadSparseModel(scene_.Training().sparse);
   const int views = static_cast<int>(truth.Images().size());
   const uint64_t long_side = std::max(truth.Cameras().front().width, truth.Cameras().front().height);
+  // The smoke grid: the default, the cheaper resolution the checks compare it with, the baseline.
+  const std::set<std::string> smoke_ids = {"balanced", "balanced_half", "fast", "sgbm"};
   for (const Setting& setting : settings) {
     if (setting.id == "balanced_1536" && long_side <= 1536) continue;  // The same as full size.
+    if (Smoke() && !smoke_ids.contains(setting.id)) continue;
     const fs::path workspace = out_ / ("depth_" + setting.id);
     fs::remove_all(workspace);
     fs::copy(base, workspace, fs::copy_options::recursive);
@@ -225,6 +234,10 @@ void Bench::Render() {
   settings.push_back({"mesh", 4, "none"});
   settings.push_back({"mesh", 4, "inpaint"});
   settings.push_back({"naive", 1, "inpaint", 0, true});
+  if (Smoke()) {
+    // The default, its hole sources off, and the baseline.
+    settings = {{"mesh", 4, "depth-aware"}, {"mesh", 4, "depth-aware", 2}, {"naive", 1, "inpaint", 0, true}};
+  }
   if (real_) {
     // Each evaluation renders full-size held-out photos: the knobs that matter on them only.
     settings = {{"mesh", 2, "depth-aware"}, {"mesh", 4, "depth-aware", 2}, {"mesh", 4, "depth-aware", 2},
@@ -296,12 +309,19 @@ void Bench::Shadows() {
     rows.push_back({"shadows", "parallax", setting, metrics, NumberAfter(run.output, "light moving: median ", log),
                     run.wall_s, run.peak_mb, false});
   };
-  for (const int size : {512, 1024, 2048, 4096}) {
-    for (const int radius : {0, 1, 2}) {
-      const std::string mode = radius == 0 ? "map" : "pcf";
-      measure(mode, mode + std::to_string(radius) + "_" + std::to_string(size),
-              mode + (radius > 0 ? " r=" + std::to_string(radius) : "") + " " + std::to_string(size) + "^2",
-              {"--shadow-map-size", std::to_string(size), "--pcf-radius", std::to_string(radius)});
+  const auto measure_map = [&](int size, int radius) {
+    const std::string mode = radius == 0 ? "map" : "pcf";
+    measure(mode, mode + std::to_string(radius) + "_" + std::to_string(size),
+            mode + (radius > 0 ? " r=" + std::to_string(radius) : "") + " " + std::to_string(size) + "^2",
+            {"--shadow-map-size", std::to_string(size), "--pcf-radius", std::to_string(radius)});
+  };
+  if (Smoke()) {
+    // The default, and the coarsest and finest plain maps.
+    measure_map(2048, 1);
+    for (const int size : {512, 4096}) measure_map(size, 0);
+  } else {
+    for (const int size : {512, 1024, 2048, 4096}) {
+      for (const int radius : {0, 1, 2}) measure_map(size, radius);
     }
   }
   // The other methods of the source texts, which have no knob.
@@ -345,7 +365,7 @@ void Bench::LeaveOut() {
 
 }  // namespace
 
-BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir) {
+BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir, BenchGrid grid) {
   const SceneFolder scene{scene_dir};
   if (!fs::is_directory(scene.Training().sparse) || !fs::is_directory(scene.Novel().sparse)) {
     throw BadInputError(scene_dir.string() + " has no ground truth (gt/sparse, novel/sparse): "
@@ -353,7 +373,7 @@ BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir) {
                         "ground-truth cameras and held-out photos (../shared/datasets)");
   }
   const auto start = std::chrono::steady_clock::now();
-  Bench bench(scene_dir, out_dir);
+  Bench bench(scene_dir, out_dir, grid);
   bench.StructureFromMotion();
   bench.Depth();
   bench.Render();

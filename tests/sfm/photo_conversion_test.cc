@@ -87,7 +87,7 @@ TEST(PhotoConversion, FormsColmapCannotReadAreFlaggedAndTheOthersAreNot) {
   EXPECT_TRUE(set.NeedsConversion());
 }
 
-// One camera per size, EXIF camera and EXIF focal length (pipeline/sfm_stages.h CameraSharing).
+// One camera per size, EXIF camera and EXIF focal length (pipeline/sfm_policy.h CameraSharing).
 TEST(PhotoSet, PhotosAreGroupedByCameraAndFocalLength) {
   const TempDir dir;
   float shade = 0;  // Sets one pixel apart in each: identical copies would be skipped.
