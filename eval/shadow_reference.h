@@ -11,7 +11,7 @@
 #include "core/image.h"
 #include "geometry/ground_plane.h"
 #include "geometry/obj.h"
-#include "viewer/renderer.h"
+#include "viewer/frame.h"
 
 namespace parallax {
 

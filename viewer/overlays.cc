@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "viewer/shaders.h"
 #include "viewer/view_math.h"
 
 namespace parallax {
@@ -122,6 +123,37 @@ std::vector<gpu::Vertex> GridLines(const ViewerScene& scene) {
     AddLine(lines, origin - extent * u + s * v, origin + extent * u + s * v, color);
   }
   return lines;
+}
+
+OverlayPass::OverlayPass(const ViewerScene& scene)
+    : program_("lines", shaders::kLineVertex, shaders::kLineFragment), frustum_depth_(FrustumDepth(scene)) {
+  for (const ViewerSource& source : scene.sources) source_centres_.push_back(CameraCenter(source.cam_from_world));
+  if (!scene.sources.empty()) frusta_ = gpu::Upload(FrustumLines(scene.sources, frustum_depth_));
+  grid_ = gpu::Upload(GridLines(scene));
+}
+
+void OverlayPass::Draw(const FrameContext& frame) const {
+  program_.Use();
+  program_.Set("u_clip_from_world", frame.clip_from_world);
+  program_.Set("u_linear_output", frame.hdr ? 1 : 0);
+  if (frame.settings.show_grid) {
+    glBindVertexArray(grid_.vao.Get());
+    glDrawArrays(GL_LINES, 0, grid_.count);
+  }
+  if (frame.settings.show_cameras && frusta_.count > 0) DrawFrusta(CameraCenter(frame.view.cam_from_world));
+  glBindVertexArray(0);
+}
+
+void OverlayPass::DrawFrusta(const Eigen::Vector3d& eye_centre) const {
+  glBindVertexArray(frusta_.vao.Get());
+  GLint first = 0;
+  for (size_t i = 0; i < source_centres_.size(); ++i) {
+    if ((source_centres_[i] - eye_centre).norm() >= 3 * frustum_depth_) continue;
+    const GLint skipped = static_cast<GLint>(i) * kFrustumVertices;
+    if (skipped > first) glDrawArrays(GL_LINES, first, skipped - first);
+    first = skipped + kFrustumVertices;
+  }
+  if (frusta_.count > first) glDrawArrays(GL_LINES, first, frusta_.count - first);
 }
 
 }  // namespace parallax

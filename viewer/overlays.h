@@ -1,8 +1,13 @@
 #pragma once
 // What the viewer draws besides the surfaces, as vertices for the GPU: the fused cloud's
-// points, each source camera's frustum, and a grid on the ground.
+// points, each source camera's frustum, and a grid on the ground; and the pass that draws the
+// frusta and the grid as lines over the frame (OverlayPass, needs a current GL context).
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "viewer/frame_context.h"
+#include "viewer/gl.h"
 #include "viewer/gpu_resources.h"
 #include "viewer/viewer_scene.h"
 
@@ -25,5 +30,25 @@ double FrustumDepth(const ViewerScene& scene);
 // A square grid with round steps on the ground (or, without one, under the scene, normal to
 // `up`), covering the footprint of the robust extent: outliers do not stretch it.
 std::vector<gpu::Vertex> GridLines(const ViewerScene& scene);
+
+// The ground grid and the source cameras' frusta, drawn as colored lines.
+class OverlayPass {
+ public:
+  // Uploads the lines. Throws std::runtime_error if the program does not compile.
+  explicit OverlayPass(const ViewerScene& scene);
+
+  // Draws what the settings show of the grid and the frusta, depth-tested against the frame.
+  void Draw(const FrameContext& frame) const;
+
+ private:
+  // The frusta but those of cameras within three frustum depths of the eye: the one looked
+  // through, or one just in front of the eye, would cross the whole image.
+  void DrawFrusta(const Eigen::Vector3d& eye_centre) const;
+
+  GlProgram program_;
+  gpu::Drawable frusta_, grid_;
+  double frustum_depth_ = 0;  // Scene units.
+  std::vector<Eigen::Vector3d> source_centres_;
+};
 
 }  // namespace parallax

@@ -1,0 +1,84 @@
+#include "viewer/tone_mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "viewer/shaders.h"
+
+namespace parallax {
+
+ToneMapper::ToneMapper()
+    : program_("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment), empty_vao_(MakeGlVertexArray()) {}
+
+double ToneMapper::LogAverageLuminance(const gpu::EyeTarget& eye) {
+  constexpr int kMeterWidth = 64, kMeterHeight = 36;
+  if (meter_.Get() == 0) {
+    meter_ = gpu::MakeTextureOnScratchUnit();
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kMeterWidth, kMeterHeight, 0, GL_RGBA, GL_FLOAT, nullptr);
+    gpu::SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
+    meter_framebuffer_ = MakeGlFramebuffer();
+    glBindFramebuffer(GL_FRAMEBUFFER, meter_framebuffer_.Get());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, meter_.Get(), 0);
+  }
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.hdr_framebuffer.Get());
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, meter_framebuffer_.Get());
+  glBlitFramebuffer(0, 0, eye.width, eye.height, 0, 0, kMeterWidth, kMeterHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  std::vector<float> texels(static_cast<size_t>(kMeterWidth) * kMeterHeight * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, meter_framebuffer_.Get());
+  glReadPixels(0, 0, kMeterWidth, kMeterHeight, GL_RGBA, GL_FLOAT, texels.data());
+  double sum_log = 0;
+  for (size_t i = 0; i < texels.size(); i += 4) {
+    const double luminance = 0.2126 * static_cast<double>(texels[i]) + 0.7152 * static_cast<double>(texels[i + 1]) +
+                             0.0722 * static_cast<double>(texels[i + 2]);
+    sum_log += std::log(std::max(luminance, 0.0) + 1e-4);  // The offset keeps black pixels finite.
+  }
+  return std::exp(sum_log / static_cast<double>(kMeterWidth * kMeterHeight));
+}
+
+double ToneMapper::Exposure(const FrameSettings& settings, const gpu::EyeTarget& eye) {
+  double exposure = std::exp2(settings.exposure_stops);
+  if (!settings.auto_exposure) return exposure;
+  const double luminance = LogAverageLuminance(eye);
+  const auto now = std::chrono::steady_clock::now();
+  if (!adapted_luminance_ || settings.adaptation_seconds <= 0) {
+    adapted_luminance_ = luminance;
+  } else {
+    // The eye closes the gap to the frame's brightness exponentially in time.
+    const double dt = std::chrono::duration<double>(now - last_adaptation_).count();
+    *adapted_luminance_ +=
+        (luminance - *adapted_luminance_) * (1 - std::exp(-dt / static_cast<double>(settings.adaptation_seconds)));
+  }
+  last_adaptation_ = now;
+  constexpr double kMiddleGrey = 0.18;
+  exposure *= kMiddleGrey / *adapted_luminance_;
+  return exposure;
+}
+
+void ToneMapper::Map(const FrameSettings& settings, const gpu::EyeTarget& eye, bool with_aux) {
+  const double exposure = Exposure(settings, eye);
+  glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
+  const GLenum color_only = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &color_only);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_STENCIL_TEST);
+  glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
+  glBindTexture(GL_TEXTURE_2D, eye.hdr.Get());
+  glActiveTexture(GL_TEXTURE0);
+  program_.Use();
+  program_.Set("u_hdr", gpu::kScratchUnit);
+  program_.Set("u_exposure", static_cast<float>(exposure));
+  // Auto exposure alone, on an 8-bit frame that would clip, maps as Reinhard does.
+  const ToneMap op = settings.tone_map == ToneMap::kClamp ? ToneMap::kReinhard : settings.tone_map;
+  program_.Set("u_operator", op == ToneMap::kReinhard ? 1 : op == ToneMap::kAces ? 2 : 0);
+  program_.Set("u_white", settings.white);
+  glBindVertexArray(empty_vao_.Get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glEnable(GL_DEPTH_TEST);
+  const GLenum both[2] = {GL_COLOR_ATTACHMENT0, with_aux ? GLenum{GL_COLOR_ATTACHMENT1} : GLenum{GL_NONE}};
+  glDrawBuffers(2, both);
+}
+
+}  // namespace parallax
