@@ -46,7 +46,7 @@ struct Screenshot {
 };
 
 // Renders `scene` with `settings` and writes the PNG. Throws BadInputError for an unknown
-// camera name, GlError when no OpenGL context can be made.
+// camera name, ToolError when no OpenGL context can be made (egl_context.h).
 Screenshot TakeScreenshot(const ViewerScene& scene, const FrameSettings& settings,
                           const ScreenshotOptions& options);
 
