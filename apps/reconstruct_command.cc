@@ -85,6 +85,13 @@ void RegisterReconstructCommand(CLI::App& app) {
                           "photo with its most similar, from a vocabulary tree built from the "
                           "photos)")
       ->transform(CLI::CheckedTransformer(matchers, CLI::ignore_case));
+  command->add_option("--vocab-tree", arguments->options.vocab_tree,
+                      "vocabulary tree for sequential and retrieval matching, used instead of "
+                      "building one from the photos: one colmap vocab_tree_builder wrote (e.g. "
+                      "<ws>/sfm/vocab_tree.bin of an earlier workspace), or one of COLMAP's "
+                      "pre-built trees (vocab_tree_flickr100K_words32K.bin and the like) for "
+                      "COLMAP 3.8; unused by exhaustive matching")
+      ->type_name("FILE");
   const std::map<std::string, MapperChoice> mappers = {{"auto", MapperChoice::kAuto},
                                                        {"incremental", MapperChoice::kIncremental},
                                                        {"hierarchical", MapperChoice::kHierarchical},
@@ -154,7 +161,9 @@ void RegisterReconstructCommand(CLI::App& app) {
       const SlurmOptions slurm = arguments->slurm.Resolve();
       const SlurmSubmission submission =
           SubmitReconstructToSlurm(arguments->photos, arguments->workspace, options, ThisExecutable(),
-                                   JobArguments(*command, {arguments->photos, arguments->workspace}), slurm);
+                                   JobArguments(*command, {arguments->photos, arguments->workspace},
+                                                {"--known-cameras", "--vocab-tree"}),
+                                   slurm);
       PrintSubmission(submission, slurm.wait);
       return;
     }

@@ -1,6 +1,7 @@
 #include "pipeline/reconstruct.h"
 
 #include <algorithm>
+#include <fstream>
 #include <optional>
 #include <set>
 #include <utility>
@@ -34,6 +35,18 @@ void CheckWorkspaceWritable(const fs::path& workspace) {
     throw BadInputError("workspace " + workspace.string() + " is not writable");
   }
   fs::remove(probe, error);
+}
+
+// ReconstructOptions::vocab_tree, when given: a file that can be read. Throws BadInputError
+// naming it.
+void CheckVocabularyTree(const fs::path& tree) {
+  if (tree.empty()) return;
+  const std::string name = "vocabulary tree " + tree.string();
+  std::error_code error;
+  if (!fs::exists(tree, error)) throw BadInputError(name + " does not exist");
+  if (!fs::is_regular_file(tree, error)) throw BadInputError(name + " is not a file");
+  if (fs::file_size(tree, error) == 0) throw BadInputError(name + " is empty");
+  if (!std::ifstream(tree, std::ios::binary)) throw BadInputError(name + " cannot be read");
 }
 
 void FillModelStatistics(const SparseModel& model, const PhotoSet& photos,
@@ -249,6 +262,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   // Everything that can be checked is checked before colmap starts.
   const Colmap colmap(options.colmap);
   const PhotoSet photos = ScanPhotos(photos_dir);
+  CheckVocabularyTree(options.vocab_tree);
   std::optional<SparseModel> known;
   if (!options.known_cameras.empty()) known = ReadSparseModel(options.known_cameras);
   if (!options.dry_run) CheckWorkspaceWritable(workspace);
@@ -270,6 +284,10 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                        MatcherFor(options, num_images), progress};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = PlannedMatcher(options, num_images);
+  if (!options.vocab_tree.empty() && sfm.matcher == MatcherChoice::kExhaustive) {
+    summary.notes.push_back("vocabulary tree " + options.vocab_tree.string() +
+                            " not used: exhaustive matching pairs every image without one");
+  }
 
   const std::string conversions = DescribeConversions(photos, paths);
   if (!conversions.empty()) summary.notes.push_back(conversions);

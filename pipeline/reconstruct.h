@@ -23,7 +23,8 @@ namespace parallax {
 // features; best: 3200 px, 8192 features and guided matching.
 
 // How photos are paired for feature matching. Sequential and retrieval use a vocabulary tree
-// that parallax builds from the photos' own features (no tree file is needed).
+// that parallax builds from the photos' own features (no tree file is needed), or the one
+// ReconstructOptions::vocab_tree names.
 enum class MatcherChoice {
   kAuto,        // Exhaustive up to `exhaustive_limit` images; past it, sequential when photos
                 // consecutive in name order match each other (an ordered capture), else retrieval.
@@ -81,6 +82,10 @@ struct ReconstructOptions {
   // Share of consecutive photos (name order) that must match for the automatic matcher to
   // treat the capture as ordered.
   double ordered_share = 0.8;
+  // A vocabulary tree file (colmap's format: one vocab_tree_builder wrote, or one of COLMAP's
+  // pre-built trees) for sequential and retrieval matching, used instead of building one from
+  // the photos. Empty: built. Unused by exhaustive matching.
+  std::filesystem::path vocab_tree;
   // A camera shared by at least this many photos gets its principal point refined in a final
   // bundle adjustment (COLMAP keeps it at the image centre, which skews the rotations of
   // photos whose principal point is off-centre).

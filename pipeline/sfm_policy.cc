@@ -37,6 +37,12 @@ std::string PastTheLimit(const ReconstructOptions& options, int num_images) {
          std::to_string(options.exhaustive_limit) + " for exhaustive matching";
 }
 
+// The vocabulary tree sequential and retrieval matching use.
+std::string TreeText(const ReconstructOptions& options) {
+  return options.vocab_tree.empty() ? "a vocabulary tree built from these photos"
+                                    : "the vocabulary tree " + options.vocab_tree.string();
+}
+
 }  // namespace
 
 CameraSetup ChooseCameraSetup(const PhotoSet& photos, const ReconstructOptions& options,
@@ -168,12 +174,12 @@ std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& opt
     case MatcherChoice::kSequential:
       text = "sequential (each image with the next " +
              std::to_string(options.sequential_overlap - 1) +
-             " in name order and those a power of two ahead; loops closed by retrieval from a "
-             "vocabulary tree built from these photos)";
+             " in name order and those a power of two ahead; loops closed by retrieval from " +
+             TreeText(options) + ")";
       break;
     case MatcherChoice::kRetrieval:
       text = "retrieval (each image with its " + std::to_string(options.retrieval_images) +
-             " most similar in a vocabulary tree built from these photos)";
+             " most similar in " + TreeText(options) + ")";
       break;
     case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
   }

@@ -1,15 +1,18 @@
 #include "pipeline/sfm_stages.h"
 
 #include <algorithm>
+#include <fstream>
 #include <functional>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 
 #include <tbb/parallel_for.h>
 
 #include "colmap/database.h"
 #include "colmap/raw_model.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/interrupt.h"
 #include "core/hash.h"
 #include "pipeline/key_photos.h"
@@ -27,6 +30,27 @@ struct TemporaryDatabase {
       : file(path), wal(path.string() + "-wal"), shm(path.string() + "-shm"), journal(path.string() + "-journal") {}
   TemporaryOutput file, wal, shm, journal;
 };
+
+// The vocabulary tree sequential and retrieval matching read: the user's, or the one the
+// vocabulary tree stage built.
+fs::path VocabularyTreeFile(const SfmContext& sfm) {
+  return sfm.options.vocab_tree.empty() ? sfm.workspace.VocabularyTree() : sfm.options.vocab_tree;
+}
+
+// The content of `file`, read in pieces (COLMAP's largest pre-built tree is about 1 GB).
+// Throws BadInputError naming a file that cannot be read.
+std::string HashFileContent(const fs::path& file) {
+  std::ifstream stream(file, std::ios::binary);
+  if (!stream) throw BadInputError("cannot read " + file.string());
+  Hasher hasher;
+  std::string piece(1 << 20, '\0');
+  while (stream) {
+    stream.read(piece.data(), static_cast<std::streamsize>(piece.size()));
+    hasher.Add(std::string_view(piece.data(), static_cast<size_t>(stream.gcount())));
+  }
+  if (stream.bad()) throw BadInputError("cannot read " + file.string());
+  return hasher.Hex();
+}
 
 // One run of the matches stage: colmap's matchers on the database being written.
 struct Matching {
@@ -47,7 +71,7 @@ struct Matching {
 
   void Run(MatcherChoice matcher) const {
     std::vector<std::string> arguments = common;
-    const std::string tree = sfm.workspace.VocabularyTree().string();
+    const std::string tree = VocabularyTreeFile(sfm).string();
     const std::string neighbours = std::to_string(sfm.options.retrieval_images);
     switch (matcher) {
       case MatcherChoice::kExhaustive: return Run("exhaustive_matcher", arguments, "matches");
@@ -198,6 +222,14 @@ Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key
                   .Hex();
   if (sfm.matcher == MatcherChoice::kExhaustive) {
     stage.not_needed = "exhaustive matching pairs every image without one";
+    stage.run = [] {};
+    return stage;
+  }
+  if (!sfm.options.vocab_tree.empty()) {
+    // The matches stage chains this key: another tree, or this one changed, matches again.
+    stage.key =
+        Hasher().Add(features_key).Add("vocab-tree-file").Add(HashFileContent(sfm.options.vocab_tree)).Hex();
+    stage.not_needed = "the vocabulary tree " + sfm.options.vocab_tree.string() + " is used (--vocab-tree)";
     stage.run = [] {};
     return stage;
   }

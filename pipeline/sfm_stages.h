@@ -51,7 +51,9 @@ MapperPlan PlanMapper(const SfmContext& sfm);
 // `photos_key` is PhotosStage's key.
 Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key);
 // The vocabulary tree sequential and retrieval matching need, built from the photos' own
-// features by colmap vocab_tree_builder; not needed for exhaustive matching.
+// features by colmap vocab_tree_builder; not needed for exhaustive matching, nor with
+// ReconstructOptions::vocab_tree, whose content its key then hashes (the matches stage's key
+// chains it).
 Stage VocabularyTreeStage(const SfmContext& sfm, const std::string& features_key);
 Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
                    const std::string& vocabulary_tree_key);

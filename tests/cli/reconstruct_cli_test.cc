@@ -279,6 +279,23 @@ TEST(ReconstructCli, BadIntrinsicsAndModelsAreUsageErrors) {
       "unknown camera model 'FISHEYE9'");
 }
 
+TEST(ReconstructCli, AVocabularyTreeIsCheckedBeforeColmapAndThenUsedInsteadOfBuilt) {
+  const TempDir dir;
+  const fs::path missing = dir.Path() / "missing.bin";
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--vocab-tree " + Quote(missing.string()))),
+                2, "vocabulary tree " + missing.string() + " does not exist");
+  ExpectFailure(RunParallax(Reconstruct(kSmallImages, dir.Path() / "ws", "--vocab-tree " + Quote(dir.Path().string()))),
+                2, "vocabulary tree " + dir.Path().string() + " is not a file");
+  const fs::path tree = dir.Path() / "tree.bin";
+  std::ofstream(tree) << "a tree";
+  const CliResult plan = RunParallax(
+      Reconstruct(kSmallImages, dir.Path() / "ws", "--matcher retrieval --dry-run --vocab-tree " + Quote(tree.string())));
+  EXPECT_EQ(plan.exit_code, 0) << plan.output;
+  EXPECT_NE(plan.output.find("vocabulary tree skipped: the vocabulary tree " + tree.string() + " is used"),
+            std::string::npos)
+      << plan.output;
+}
+
 TEST(ReconstructCli, ColmapFailingExitsThreeWithItsStatusLastLinesAndLog) {
   const TempDir dir;
   const fs::path photos = dir.Path() / "photos";

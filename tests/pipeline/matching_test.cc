@@ -1,7 +1,8 @@
 // The matcher past the exhaustive limit, through the real colmap on example_images/courtyard
 // (24 photos 15 degrees apart on a ring; every other one is too sparse for SfM at fast
 // quality): sequential for photos in capture order, retrieval when their names are shuffled,
-// both from a vocabulary tree built from the photos.
+// both from a vocabulary tree built from the photos (built once, in the ordered run, and given
+// to the shuffled one as --vocab-tree would).
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -76,18 +77,27 @@ TEST(Matching, OrderedPhotosMatchSequentiallyShuffledOnesByRetrieval) {
   EXPECT_LT(ReadVerifiedPairs(Workspace(ordered.Path()).Database()).size(), 276u / 2);
 
   // Every 7th photo next: neighbours in name order are 105 degrees apart and share nothing.
+  // The same photos' features: the ordered run's tree serves, and is not built again.
   const TempDir shuffled_photos, unordered;
   CopyPhotos(shuffled_photos.Path(), [](int i) { return "shuffled_" + std::to_string(10 + (i * 7) % 24) + ".png"; });
+  ReconstructOptions given_tree = options;
+  given_tree.vocab_tree = Workspace(ordered.Path()).VocabularyTree();
   const ReconstructSummary retrieval =
-      Reconstruct(shuffled_photos.Path(), unordered.Path(), options, progress);
+      Reconstruct(shuffled_photos.Path(), unordered.Path(), given_tree, progress);
   EXPECT_NE(retrieval.matcher.find("retrieval"), std::string::npos) << retrieval.matcher;
   EXPECT_NE(retrieval.matcher.find("not an ordered capture"), std::string::npos) << retrieval.matcher;
+  EXPECT_NE(retrieval.matcher.find("the vocabulary tree " + given_tree.vocab_tree.string()), std::string::npos)
+      << retrieval.matcher;
+  const StageRecord& tree = StageNamed(retrieval, "vocabulary tree");
+  EXPECT_TRUE(tree.skipped);
+  EXPECT_NE(tree.reason.find(given_tree.vocab_tree.string()), std::string::npos) << tree.reason;
+  EXPECT_FALSE(fs::exists(Workspace(unordered.Path()).VocabularyTree()));
   EXPECT_EQ(retrieval.images_registered, 24);
   EXPECT_LT(retrieval.mean_reprojection_error_px, 1.0);
   EXPECT_LT(ReadVerifiedPairs(Workspace(unordered.Path()).Database()).size(), 276u / 2);
 
   // A second run skips every stage, the vocabulary tree too, and still says which matcher ran.
-  const ReconstructSummary again = Reconstruct(shuffled_photos.Path(), unordered.Path(), options, progress);
+  const ReconstructSummary again = Reconstruct(shuffled_photos.Path(), unordered.Path(), given_tree, progress);
   for (const StageRecord& stage : again.stages) EXPECT_TRUE(stage.skipped) << stage.name;
   EXPECT_EQ(again.matcher, retrieval.matcher);
 }
