@@ -2,20 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 #include <tbb/parallel_for.h>
 
 #include "reproject/background.h"
 #include "reproject/rasterizer.h"
+#include "reproject/row_window.h"
 #include "reproject/simd.h"
 #include "reproject/warp_rows.h"
 #include "core/check.h"
@@ -33,20 +28,18 @@ using warp_internal::PenaliseSilhouetteRow;
 using warp_internal::ProjectRow;
 using warp_internal::Vertices;
 using warp_internal::WarpSetup;
+using warp_internal::Allocate;
+using warp_internal::BandScratch;
+using warp_internal::kMaxBlock;
+using warp_internal::RowWindow;
 using warp_internal::kInvalid;
 using warp_internal::kSky;
 using warp_internal::kSurface;
 
 }  // namespace
 
-// What each band of a warp prepares and marks for itself (every band walks the whole source).
-struct BandScratch {
-  Vertices vertices;
-  std::vector<uint8_t> silhouette_marks;  // Mesh: PenaliseSilhouetteRow's, one row.
-};
-
 struct WarpScratch::Data {
-  std::vector<BandScratch> bands;
+  std::vector<warp_internal::BandScratch> bands;
   std::vector<uint8_t> background;  // MarkBackground, when the source has none to share.
   const std::vector<uint8_t>* background_used = nullptr;  // This or the source's; null: none.
   std::vector<size_t> stack;        // MarkBackground's flood fill.
@@ -69,135 +62,6 @@ void MakeTexture(const Image& color, std::vector<uint16_t>* texture) {
   }
 }
 
-template <typename T>
-void Allocate(PixelArray<T>* array, size_t count) {
-  // Per-pixel arrays of a megabyte and more start on a huge page and are advised to use them
-  // (Linux): a warp writes and reads them scattered across the image, missing the TLB with
-  // 4 KB pages.
-  constexpr size_t kHugePage = size_t{2} << 20;
-  const size_t bytes = count * sizeof(T);
-  if (bytes < (size_t{1} << 20)) {
-    array->reset(static_cast<T*>(std::malloc(std::max<size_t>(bytes, 1))));
-  } else {
-    const size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
-    array->reset(static_cast<T*>(std::aligned_alloc(kHugePage, rounded)));
-#if defined(__linux__)
-    if (*array) madvise(array->get(), rounded, MADV_HUGEPAGE);
-#endif
-  }
-  if (!*array) throw std::bad_alloc();
-}
-
-// The side of the largest blocks of the mesh (SourceWarper::Mesh), the grid they start on.
-// 8: as accurate as 4 and 16 on the courtyard's novel views.
-constexpr int kMaxBlock = 8;
-
-// A band's vertices (with, for a mesh, the quads and silhouette penalties), prepared in source
-// row order as its walk reaches them, and only the few rows the walk reads at a time kept:
-// they stay in cache, where a whole source's vertices (~5 MB at 640x480), prepared first,
-// came back from memory out of a cache that the other thread's warp shares.
-class RowWindow {
- public:
-  // A block row of the mesh reads the vertex rows from the one above it to the one below it
-  // (its splats and the quads of its last row): kMaxBlock + 3.
-  static constexpr int kRows = kMaxBlock + 3;
-
-  RowWindow(const WarpSetup& setup, const SourceView& source, const uint8_t* background,
-            const float* ray_x, const ForwardWarpOptions& options, BandScratch* band)
-      : s_(setup), source_(source), background_(background), ray_x_(ray_x),
-        mesh_(options.method == WarpMethod::kMesh),
-        penalty_(static_cast<float>(options.silhouette_angle_rad)), band_(band) {
-    const auto width = static_cast<size_t>(s_.src.width);
-    Vertices& vertices = band_->vertices;
-    const size_t count = static_cast<size_t>(kRows) * width;
-    if (count > vertices.capacity) {
-      Allocate(&vertices.u, count);
-      Allocate(&vertices.v, count);
-      Allocate(&vertices.inv_z, count);
-      Allocate(&vertices.angle, count);
-      Allocate(&vertices.kind, count);
-      Allocate(&vertices.quads, count);
-      Allocate(&vertices.edges, count);
-      vertices.capacity = count;
-    }
-    vertices.offset = 0;
-    if (mesh_) band_->silhouette_marks.resize(width);
-  }
-
-  Vertices& Get() { return band_->vertices; }
-
-  // Vertex rows first to last (clamped to the image) prepared and in the window: projected,
-  // and for a mesh with the quads below them and their silhouette penalties. Rows above
-  // `first` may leave the window. Throws std::logic_error when more rows than kRows are asked
-  // for at once.
-  void Through(int first, int last) {
-    const int height = s_.src.height;
-    last = std::min(last, height - 1);
-    for (; complete_ <= last; ++complete_) {
-      // The quads of row r join the kinds of rows r and r + 1; its penalties read quads
-      // r - 1 and r.
-      for (; projected_ <= std::min(complete_ + 1, height - 1); ++projected_) {
-        if (projected_ - first_ >= kRows) Slide(first);
-        ProjectRow(s_, source_, background_, ray_x_, projected_, &band_->vertices);
-        if (mesh_) MarkBorder(projected_);
-      }
-      if (!mesh_) continue;
-      ContinuousRow(source_, s_, complete_, &band_->vertices);
-      if (penalty_ > 0) {
-        PenaliseSilhouetteRow(s_, penalty_, complete_, band_->silhouette_marks.data(),
-                              &band_->vertices);
-      }
-    }
-  }
-
- private:
-  // The edge marks of row y: the image border only, so far.
-  void MarkBorder(int y) {
-    const int width = s_.src.width;
-    if (width == 0) return;
-    uint8_t* edges = band_->vertices.edges.get() +
-                     band_->vertices.At(static_cast<size_t>(y) * static_cast<size_t>(width));
-    const bool border_row = y == 0 || y == s_.src.height - 1;
-    std::fill(edges, edges + width, static_cast<uint8_t>(border_row ? 1 : 0));
-    edges[0] = 1;
-    edges[width - 1] = 1;
-  }
-
-  // Moves the projected rows from `first` on to the start of the window.
-  void Slide(int first) {
-    first = std::max(first, first_);
-    if (projected_ - first >= kRows) {
-      throw std::logic_error("RowWindow: more than " + std::to_string(kRows) + " rows at once");
-    }
-    const auto width = static_cast<size_t>(s_.src.width);
-    const size_t from = static_cast<size_t>(first - first_) * width;
-    const size_t kept = static_cast<size_t>(projected_ - first) * width;
-    Vertices& vertices = band_->vertices;
-    const auto slide = [&](auto& array) {
-      std::copy(array.get() + from, array.get() + from + kept, array.get());
-    };
-    slide(vertices.u);
-    slide(vertices.v);
-    slide(vertices.inv_z);
-    slide(vertices.angle);
-    slide(vertices.kind);
-    slide(vertices.quads);
-    slide(vertices.edges);
-    first_ = first;
-    vertices.offset = static_cast<size_t>(first) * width;
-  }
-
-  const WarpSetup& s_;
-  const SourceView& source_;
-  const uint8_t* background_;
-  const float* ray_x_;
-  bool mesh_;
-  float penalty_;
-  BandScratch* band_;
-  int first_ = 0;      // The window's first row.
-  int projected_ = 0;  // Rows projected: [0, projected_).
-  int complete_ = 0;   // Rows prepared: [0, complete_).
-};
 
 class SourceWarper {
  public:
