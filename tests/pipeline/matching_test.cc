@@ -117,7 +117,8 @@ TEST(Matching, AnAutomaticChoiceUpToTheLimitIsExhaustiveAndNeedsNoTree) {
 
 // Past a hierarchical limit of 10 images the 24 photos are mapped in clusters of at most 10,
 // overlapping by 5, and merged into one model: every photo registered, the rotations a little
-// worse than one incremental model's (as on the plaza at 400 views, docs/scale.md).
+// worse than one incremental model's (as on the plaza at 400 views, docs/scale.md). (16 photos
+// on an arc, not the ring, gave rotations 1.6 to 2 degrees off in 1 of 6 runs.)
 TEST(Mapping, PastTheLimitClustersAreMappedApartAndMerged) {
   ReconstructOptions options;
   options.quality = Quality::kFast;
@@ -132,6 +133,7 @@ TEST(Mapping, PastTheLimitClustersAreMappedApartAndMerged) {
             std::string::npos) << summary.mapper;
   const std::string log = ReadFileBytes(Workspace(workspace.Path()).Log("mapper"));
   EXPECT_NE(log.find("Partitioning scene"), std::string::npos);
+  EXPECT_NE(log.find("Cluster 2 with"), std::string::npos);  // Two clusters or more.
   const PoseEvaluation poses = EvaluatePoses(ReadSparseModel(workspace.Path() / "sparse"),
                                              ReadSparseModel(SceneFolder{kCourtyard}.Training().sparse));
   EXPECT_EQ(poses.registered, 24);
@@ -194,14 +196,17 @@ TEST(Mapping, KeyPhotosAreMappedAndTheOthersRegisteredToThem) {
   EXPECT_LT(poses.rotation_error_mean_deg, 0.3);
   EXPECT_LT(summary.mean_reprojection_error_px, 1.0);
 
-  // Run again, nothing runs; forced incremental, only the mapper runs again.
+  // Run again, nothing runs; forced incremental, only the mapper would run again (a dry run
+  // plans with the keys a run skips by: mapping all 72 photos adds nothing to check here).
   const ReconstructSummary again = Reconstruct(scene.Path() / "images", workspace.Path(), options, progress);
   for (const StageRecord& stage : again.stages) EXPECT_TRUE(stage.skipped) << stage.name;
   EXPECT_EQ(again.mapper, summary.mapper);
   options.mapper = MapperChoice::kIncremental;
+  options.dry_run = true;
   const ReconstructSummary incremental = Reconstruct(scene.Path() / "images", workspace.Path(), options, progress);
   EXPECT_EQ(incremental.mapper, "incremental (one model grown image by image)");
   EXPECT_FALSE(StageNamed(incremental, "mapper").skipped);
+  EXPECT_EQ(StageNamed(incremental, "mapper").reason, "inputs or options changed");
   EXPECT_TRUE(StageNamed(incremental, "matches").skipped);
 }
 
