@@ -104,13 +104,13 @@ std::string ImageListText(const std::vector<std::string>& names) {
 }
 
 // A final bundle adjustment that also frees the principal point, written over the raw model
-// only where CheckRefinedPrincipalPoint keeps it; returns report.json's note.
-std::string RefinePrincipalPoint(const SfmContext& sfm) {
+// only where CheckRefinedPrincipalPoint keeps it; returns the check (keep, report.json's note).
+PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   const SparseModel model = AdjustRawModel(sfm.colmap, sfm.workspace, {"--BundleAdjustment.refine_principal_point", "1"},
                                            "refine", sfm.progress);
   const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, sfm.options);
   if (check.keep) WriteSparseModel(model, sfm.workspace.RawModel(), SparseFormat::kBinary);
-  return check.note;
+  return check;
 }
 
 }  // namespace
@@ -319,7 +319,9 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
       .Add(refine_principal_point)
       .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
   // The incremental mapper keeps the keys it had before there was a choice.
-  if (hierarchical) hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images));
+  if (hierarchical) {
+    hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images)).Add("adjusted-2");
+  }
   if (key_photos) hasher.Add("key photos").Add(ImageListText(plan.key_photos));
   stage.key = hasher.Hex();
   stage.outputs = {paths.RawModel()};
@@ -353,11 +355,15 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
     // With key photos, the principal point is refined on their model: the photos registered
     // to it afterwards are not adjusted (an adjustment of them all costs twice the memory and
     // made the poses worse on the plaza, docs/scale.md).
+    bool adjusted = false;
     if (refine_principal_point) {
-      notes.push_back(RefinePrincipalPoint(sfm));
-    } else if (hierarchical) {
+      const PrincipalPointCheck check = RefinePrincipalPoint(sfm);
+      notes.push_back(check.note);
+      adjusted = check.keep;
+    }
+    if (hierarchical && !adjusted) {
       // The hierarchical mapper merges its clusters' models without a final bundle adjustment,
-      // as COLMAP's documentation warns.
+      // as COLMAP's documentation warns; a rejected refinement left the merged model as it was.
       WriteSparseModel(AdjustRawModel(sfm.colmap, paths, {}, "adjust", sfm.progress), paths.RawModel(),
                        SparseFormat::kBinary);
     }
