@@ -5,6 +5,8 @@
 #include <string>
 #include <sys/wait.h>
 
+#include "tests/test_paths.h"
+
 namespace parallax {
 
 struct CliResult {
@@ -29,7 +31,7 @@ inline CliResult RunCommand(const std::string& command) {
 
 // `arguments` is appended to the executable as shell words (quote paths with spaces).
 inline CliResult RunParallax(const std::string& arguments, const std::string& environment = "") {
-  return RunCommand(environment + " '" + std::string(PARALLAX_EXECUTABLE) + "' " + arguments);
+  return RunCommand(environment + " '" + ParallaxExecutable() + "' " + arguments);
 }
 
 inline std::string Quote(const std::string& path) { return "'" + path + "'"; }

@@ -9,6 +9,7 @@
 #include "core/workspace.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
@@ -47,7 +48,7 @@ int WorkingWidth(const fs::path& workspace) {
 // on a loaded machine they say nothing (bench/ measures them).
 TEST(BenchCli, SmallSceneReportsEveryStageAgainstItsBaselines) {
   const TempDir dir;
-  const fs::path small = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+  const fs::path small = SourceDir() / "example_images" / "small";
   const CliResult result =
       RunParallax("bench " + Quote(small.string()) + " " + Quote(dir.Path().string()) + " --grid smoke");
   ASSERT_EQ(result.exit_code, 0) << result.output;

@@ -20,6 +20,7 @@
 #include "core/workspace.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 extern char** environ;
 
@@ -28,7 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
+const fs::path kSmallImages = SourceDir() / "example_images" / "small" / "images";
 
 size_t CountFiles(const fs::path& dir, const std::string& extension) {
   if (!fs::is_directory(dir)) return 0;
@@ -63,7 +64,7 @@ void ExpectEveryFileComplete(const fs::path& workspace) {
 TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   const TempDir dir;
   const fs::path workspace = dir.Path() / "ws";
-  const std::string executable = PARALLAX_EXECUTABLE;
+  const std::string executable = ParallaxExecutable();
   const std::string photos = kSmallImages.string(), ws = workspace.string();
   const char* argv[] = {executable.c_str(), "reconstruct", photos.c_str(), ws.c_str(),
                         "--no-mesh", nullptr};
@@ -153,7 +154,7 @@ size_t ProcessesNaming(const std::string& path) {
 TEST(KillResume, SigtermStopsColmapRemovesTemporariesAndTheRerunResumes) {
   const TempDir dir;
   const fs::path workspace = dir.Path() / "ws";
-  const std::string executable = PARALLAX_EXECUTABLE;
+  const std::string executable = ParallaxExecutable();
   const std::string photos = kSmallImages.string(), ws = workspace.string();
   const char* argv[] = {executable.c_str(), "reconstruct", photos.c_str(), ws.c_str(), "--no-depth", nullptr};
   pid_t pid = 0;

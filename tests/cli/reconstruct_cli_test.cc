@@ -14,14 +14,15 @@
 #include "core/sparse_model.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
-const fs::path kCourtyardImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "courtyard" / "images";
+const fs::path kSmallImages = SourceDir() / "example_images" / "small" / "images";
+const fs::path kCourtyardImages = SourceDir() / "example_images" / "courtyard" / "images";
 // 16 of the courtyard's 24 photos, 15 degrees apart on its ring: the arc of 225 degrees from
 // 0016 through 0023 to 0007, matched in 120 pairs instead of 276. On this side of the ring
 // photos two apart share at least 47 verified matches (fast quality); across the other side

@@ -18,13 +18,14 @@
 #include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+const fs::path kSmall = SourceDir() / "example_images" / "small";
 
 std::vector<std::string> Lines(const std::string& text) {
   std::vector<std::string> lines;

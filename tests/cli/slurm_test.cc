@@ -11,14 +11,15 @@
 
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSmallImages = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small" / "images";
-const fs::path kClusterScript = fs::path(PARALLAX_SOURCE_DIR) / "scripts" / "slurm-cluster";
+const fs::path kSmallImages = SourceDir() / "example_images" / "small" / "images";
+const fs::path kClusterScript = SourceDir() / "scripts" / "slurm-cluster";
 
 // The cluster for as long as it lives: stopped whatever happens to the test.
 class SlurmCluster {

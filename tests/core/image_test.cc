@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
@@ -136,7 +137,7 @@ TEST(Image, ExrHeadersClaimingTooMuchAreRefusedBeforeDecoding) {
     EXPECT_NE(std::string(error.what()).find("claims 100000x100000 pixels, over the 128 MP limit"), std::string::npos)
         << error.what();
   }
-  const std::filesystem::path fuzzed = std::filesystem::path(PARALLAX_SOURCE_DIR) / "fuzz" / "corpus" / "image" /
+  const std::filesystem::path fuzzed = SourceDir() / "fuzz" / "corpus" / "image" /
                                        "oom-9c45bac25791af1ef2c637f764c39cf9191af3c4";
   std::ifstream input(fuzzed, std::ios::binary);
   const std::string header((std::istreambuf_iterator<char>(input)), {});

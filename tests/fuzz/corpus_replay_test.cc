@@ -7,13 +7,14 @@
 
 #include "core/atomic_file.h"
 #include "fuzz/fuzz_targets.h"
+#include "tests/test_paths.h"
 
 namespace parallax::fuzz {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kCorpus = fs::path(PARALLAX_SOURCE_DIR) / "fuzz" / "corpus";
+const fs::path kCorpus = SourceDir() / "fuzz" / "corpus";
 
 TEST(FuzzCorpus, EveryTargetHasSeeds) {
   // PARALLAX_WRITE_SEEDS=<dir> regenerates the seed files (after a format change).

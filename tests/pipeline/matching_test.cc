@@ -23,12 +23,13 @@
 #include "synth/scene.h"
 #include "synth/synth.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kCourtyard = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "courtyard";
+const fs::path kCourtyard = SourceDir() / "example_images" / "courtyard";
 
 // The courtyard's photos, the i-th under the name `name(i)`.
 void CopyPhotos(const fs::path& folder, const std::function<std::string(int)>& name) {

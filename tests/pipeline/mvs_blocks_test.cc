@@ -11,13 +11,14 @@
 #include "pipeline/depth_workspace.h"
 #include "pipeline/reconstruct.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+const fs::path kSmall = SourceDir() / "example_images" / "small";
 
 // Every file under `dir`, by its path relative to `dir`, with its bytes.
 std::map<std::string, std::string> FilesUnder(const fs::path& dir) {

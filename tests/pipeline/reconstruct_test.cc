@@ -28,12 +28,13 @@
 #include "eval/evaluate.h"
 #include "eval/workspace_evaluation.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 const std::filesystem::path kSmall =
-    std::filesystem::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+    SourceDir() / "example_images" / "small";
 
 TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   const TempDir workspace;

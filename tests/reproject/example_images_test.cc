@@ -14,6 +14,7 @@
 #include "reproject/scene_views.h"
 #include "reproject/source_selection.h"
 #include "tests/reproject/analytic_scene.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
@@ -21,7 +22,7 @@ namespace {
 class SmallScene : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const SceneFolder folder{std::filesystem::path(PARALLAX_SOURCE_DIR) / "example_images" / "small"};
+    const SceneFolder folder{SourceDir() / "example_images" / "small"};
     training_ = new std::vector<SourceView>(ReadSourceViews(folder.Training()));
     novel_ = new std::vector<SourceView>(ReadSourceViews(folder.Novel()));
   }
@@ -104,7 +105,7 @@ TEST_F(SmallScene, FourSourcesLeaveFewerHolesThanOne) {
 // EvaluateNovelViews from the ground-truth sources (as `evaluate --gt-sources`): one score
 // per novel view, in order, whose means are the evaluation's.
 TEST(SmallSceneEvaluation, PerViewScoresAverageToTheMeans) {
-  const SceneFolder folder{std::filesystem::path(PARALLAX_SOURCE_DIR) / "example_images" / "small"};
+  const SceneFolder folder{SourceDir() / "example_images" / "small"};
   const SparseModel model = ReadSparseModel(folder.Novel().sparse);
   std::vector<NamedCamera> targets;
   std::vector<std::string> names;

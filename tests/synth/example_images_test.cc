@@ -12,6 +12,7 @@
 #include "core/image.h"
 #include "synth/synth.h"
 #include "tests/temp_dir.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
@@ -48,7 +49,7 @@ void ExpectSameUpToTheLastBit(const fs::path& made, const fs::path& committed, c
 }
 
 void ExpectSynthReproduces(const std::string& scene_name) {
-  const fs::path committed = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / scene_name;
+  const fs::path committed = SourceDir() / "example_images" / scene_name;
   const TempDir out;
   const std::string json = ReadFileBytes(committed / "scene.json");
   SilentProgress progress;

@@ -10,12 +10,13 @@
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "synth/synth.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 
 const std::filesystem::path kSmallScene =
-    std::filesystem::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+    SourceDir() / "example_images" / "small";
 
 SceneDesc SmallScene() { return ReadSceneJson(kSmallScene / "scene.json"); }
 

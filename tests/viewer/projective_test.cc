@@ -11,6 +11,7 @@
 #include "tests/temp_dir.h"
 #include "testing/viewer_scenes.h"
 #include "geometry/robust_bounds.h"
+#include "tests/test_paths.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 
@@ -19,7 +20,7 @@ namespace {
 using namespace viewer_test;
 namespace fs = std::filesystem;
 
-const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+const fs::path kSmall = SourceDir() / "example_images" / "small";
 
 // The small example scene as the viewer sees a workspace: its own geometry as the mesh, its
 // ground-truth cameras and photos as the sources.

@@ -15,12 +15,13 @@
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
 #include "testing/viewer_scenes.h"
+#include "tests/test_paths.h"
 
 namespace parallax {
 namespace {
 namespace fs = std::filesystem;
 
-const fs::path kSmall = fs::path(PARALLAX_SOURCE_DIR) / "example_images" / "small";
+const fs::path kSmall = SourceDir() / "example_images" / "small";
 
 // A workspace holding the small scene's own geometry as mesh/, its cameras and photos.
 void MakeWorkspace(const fs::path& ws) {
@@ -140,7 +141,7 @@ TEST(ViewWindow, SyntheticInputDrivesEveryControl) {
   const VirtualDisplay display;
   ASSERT_TRUE(display.Ready()) << "Xvfb did not start";
   const fs::path log = dir.Path() / "view.log", exit_file = dir.Path() / "exit";
-  RunCommand("(" + display.Environment() + " '" + std::string(PARALLAX_EXECUTABLE) + "' view " +
+  RunCommand("(" + display.Environment() + " '" + ParallaxExecutable() + "' view " +
              Quote((dir.Path() / "ws").string()) + " --size 480x300 --screenshot-dir " + Quote(dir.Path().string()) +
              " > " + Quote(log.string()) + " 2>&1; echo $? > " + Quote(exit_file.string()) + ") >/dev/null 2>&1 &");
   const auto xdo = [&](const std::string& arguments) {
