@@ -70,6 +70,22 @@ void PrintCloudAndMesh(const WorkspaceEvaluation& evaluation) {
   for (const std::string& line : evaluation.not_scored) std::printf("not scored: %s\n", line.c_str());
 }
 
+// Each view's loss budget: its pixels by kind (share, PSNR, dB the frame loses to them).
+void PrintBudgets(const NovelEvaluation& result) {
+  std::printf("%-16s %21s %21s %21s %9s\n", "loss budget", "covered", "background (sky)", "filled",
+              "exposure");
+  std::printf("%-16s %21s %21s %21s %9s\n", "", "share  PSNR  lost", "share  PSNR  lost", "share  PSNR  lost", "dB");
+  const auto row = [](const std::string& name, const LossBudget& budget) {
+    std::printf("%-16s", name.c_str());
+    for (const PixelShareLoss* part : {&budget.covered, &budget.background, &budget.filled}) {
+      std::printf(" %5.1f%% %5.2f %6.2f", 100 * part->share, part->psnr, part->db_lost);
+    }
+    std::printf(" %+9.2f\n", budget.exposure_db);
+  };
+  for (const NovelViewScore& view : result.per_view) row(view.name, view.budget);
+  row("mean", result.budget_mean);
+}
+
 void PrintNovel(const NovelViewsEvaluation& novel) {
   const NovelEvaluation& result = novel.result;
   if (novel.registration_tried) {
@@ -82,6 +98,7 @@ void PrintNovel(const NovelViewsEvaluation& novel) {
     std::printf("%-16s %9.2f %7.3f %14.2f %16.2f %6.2f%%\n", view.name.c_str(), view.psnr, view.ssim,
                 view.psnr_valid, view.psnr_exposure_matched, 100 * view.hole_ratio);
   }
+  PrintBudgets(result);
   std::printf("novel views (%s%s): %d views; PSNR %.2f dB (%.2f dB on sampled pixels, %.2f dB exposure "
               "matched), SSIM %.3f; "
               "holes %.2f%% (cracks %.2f%%) -> %.2f%% after filling; out of view %.2f%%, "
@@ -107,14 +124,16 @@ void RegisterEvaluateCommand(CLI::App& app) {
   };
   auto arguments = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
-      "evaluate", "Measure a workspace against a scene folder's ground truth: camera poses "
-                  "after a robust similarity alignment (Ceres) and, when the workspace has "
-                  "depth/, its depth maps in the ground-truth cameras.");
+      "evaluate", "Measure a workspace against a scene folder's ground truth (--gt): camera poses "
+                  "after a robust similarity alignment (Ceres), depth maps, cloud and mesh where the "
+                  "scene has depth, and its held-out views. Without --gt: the photos reconstruct held "
+                  "out (--hold-out) rendered at their cameras and compared with them.");
   command->add_option("workspace", arguments->workspace, "workspace made by reconstruct")
       ->required()
       ->check(CLI::ExistingDirectory);
-  command->add_option("--gt", arguments->scene, "scene folder with ground truth (gt/sparse)")
-      ->required()
+  command->add_option("--gt", arguments->scene,
+                      "scene folder with ground truth (gt/sparse); without it, the workspace's held-out photos "
+                      "are scored")
       ->check(CLI::ExistingDirectory);
   command->add_option("--json", arguments->json,
                       "where to write the JSON (default <workspace>/evaluation.json)");
@@ -149,10 +168,11 @@ void RegisterEvaluateCommand(CLI::App& app) {
     }
     {
       TerminalProgress progress;
-      evaluation = EvaluateWorkspace(workspace, SceneFolder{arguments->scene}, arguments->options,
-                                     progress);
+      evaluation = arguments->scene.empty()
+                       ? EvaluateHeldOut(workspace, arguments->options)
+                       : EvaluateWorkspace(workspace, SceneFolder{arguments->scene}, arguments->options, progress);
     }
-    PrintPoses(evaluation.poses);
+    if (!evaluation.held_out) PrintPoses(evaluation.poses);
     PrintDepth(evaluation, workspace);
     PrintCloudAndMesh(evaluation);
     if (evaluation.novel) PrintNovel(*evaluation.novel);

@@ -119,6 +119,14 @@ void RegisterReconstructCommand(CLI::App& app) {
   command->add_option("--known-cameras", arguments->options.known_cameras,
                       "COLMAP model folder with known intrinsics and poses: only triangulate")
       ->check(CLI::ExistingDirectory);
+  command->add_option("--hold-out", arguments->options.hold_out_every,
+                      "hold out every N-th photo in name order, from the first (as novel-view benchmarks do, "
+                      "e.g. 8): registered with the others, then kept out of depth, fusion, the mesh and the "
+                      "render sources; `parallax evaluate WS` renders their cameras and scores them")
+      ->check(CLI::Range(2, 100000));
+  command->add_option("--hold-out-photos", arguments->options.hold_out_photos,
+                      "hold out these photos (names in the folder, comma-separated), as --hold-out does")
+      ->delimiter(',');
   command->add_flag("--no-depth", arguments->no_depth,
                     "stop after structure from motion (no multi-view stereo)");
   const std::map<std::string, StereoMethod> stereo_methods = {

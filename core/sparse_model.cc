@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <system_error>
+#include <unordered_set>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -241,6 +242,37 @@ SparseModel ReadSparseModelWithoutKeypoints(const fs::path& dir) {
   for (SparseImage& image : model.MutableImages()) std::vector<Point2D>().swap(image.points2d);
   ReturnFreedMemory();  // Else the keypoints' pages stay resident through the stage that reads it.
   return model;
+}
+
+SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& names, bool keep) {
+  std::unordered_set<uint32_t> images, cameras;
+  for (const SparseImage& image : model.Images()) {
+    if ((names.count(image.name) != 0) == keep) {
+      images.insert(image.id);
+      cameras.insert(image.camera_id);
+    }
+  }
+  SparseModel selected;
+  for (const Camera& camera : model.Cameras()) {
+    if (cameras.count(camera.id)) selected.AddCamera(camera);
+  }
+  std::unordered_set<uint64_t> points;
+  for (const Point3D& point : model.Points3D()) {
+    Point3D kept = point;
+    std::erase_if(kept.track, [&images](const TrackElement& element) { return !images.count(element.image_id); });
+    if (kept.track.size() < 2) continue;
+    points.insert(kept.id);
+    selected.AddPoint3D(std::move(kept));
+  }
+  for (const SparseImage& image : model.Images()) {
+    if (!images.count(image.id)) continue;
+    SparseImage kept = image;
+    for (Point2D& point : kept.points2d) {
+      if (!points.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
+    }
+    selected.AddImage(std::move(kept));
+  }
+  return selected;
 }
 
 void WriteSparseModel(const SparseModel& model, const fs::path& dir, SparseFormat format) {

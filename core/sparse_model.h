@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <limits>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -94,6 +95,11 @@ SparseModel ReadSparseModel(const std::filesystem::path& dir, SparseFormat forma
 // there are hundreds of photos), for the dense stages, which need the cameras, poses and tracks
 // only. The tracks' point2d_idx then index nothing.
 SparseModel ReadSparseModelWithoutKeypoints(const std::filesystem::path& dir);
+
+// The images of `model` whose names are in `names` (or, with `keep` false, those whose names are
+// not), the cameras they use, and the points they still observe from two or more of them; the
+// other points' observations are cleared, so that colmap reads the model as whole.
+SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& names, bool keep);
 
 // Writes cameras, images and points3D in `format` into `dir` (created if missing). Each file is
 // written to a temporary name and renamed. Throws BadInputError if `dir` is not writable.

@@ -39,6 +39,11 @@ class Workspace {
     return StereoEstimates() / (photo + ".json");
   }
 
+  // The photos held out of everything after structure from motion (reconstruct --hold-out),
+  // laid out as a workspace of their own: held_out/images and held_out/sparse (their cameras
+  // and poses in the workspace's frame, without points), for `evaluate` to render and compare.
+  Workspace HeldOut() const { return Workspace(root_ / "held_out"); }
+
   // Structure from motion's own files: the COLMAP database, the raw (distorted) models.
   std::filesystem::path Sfm() const { return root_ / "sfm"; }
   std::filesystem::path Database() const { return Sfm() / "database.db"; }

@@ -63,6 +63,73 @@ Image ExposureMatched(const Image& render, const Image& truth, const std::vector
   return LinearToSrgb(matched);
 }
 
+// The pixels whose class is in `classes`.
+std::vector<uint8_t> MaskOf(const ClassMap& map, std::initializer_list<PixelClass> classes) {
+  std::vector<uint8_t> mask(map.classes.size());
+  for (size_t p = 0; p < mask.size(); ++p) {
+    mask[p] = std::find(classes.begin(), classes.end(), map.classes[p]) != classes.end();
+  }
+  return mask;
+}
+
+PixelShareLoss ShareLoss(const Image& render, const Image& truth, const std::vector<uint8_t>& mask,
+                         double frame_psnr) {
+  PixelShareLoss loss;
+  const auto pixels = static_cast<double>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+  if (pixels == 0) return loss;
+  loss.share = pixels / static_cast<double>(mask.size());
+  loss.psnr = Psnr(render, truth, mask);
+  const double frame_mse = std::pow(10.0, -frame_psnr / 10), mse = std::pow(10.0, -loss.psnr / 10);
+  loss.db_lost = 10 * std::log10(frame_mse / std::max(frame_mse - loss.share * mse, 1e-10));
+  return loss;
+}
+
+LossBudget BudgetOf(const Image& render, const Image& truth, const ClassMap& classes, double psnr,
+                    double psnr_exposure_matched) {
+  LossBudget budget;
+  budget.covered = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kCovered}), psnr);
+  budget.background = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kBackground}), psnr);
+  budget.filled = ShareLoss(
+      render, truth, MaskOf(classes, {PixelClass::kOutOfView, PixelClass::kCrack, PixelClass::kDisocclusion}), psnr);
+  const std::vector<uint8_t> out_of_view = MaskOf(classes, {PixelClass::kOutOfView});
+  budget.out_of_view_share = static_cast<double>(std::count(out_of_view.begin(), out_of_view.end(), uint8_t{1})) /
+                             static_cast<double>(out_of_view.size());
+  budget.exposure_db = psnr_exposure_matched - psnr;
+  return budget;
+}
+
+// The mean of the views' budgets; each class's PSNR over the views that have its pixels.
+LossBudget MeanBudget(const std::vector<NovelViewScore>& views) {
+  LossBudget mean;
+  std::array<int, 3> with_pixels{0, 0, 0};
+  for (const NovelViewScore& view : views) {
+    const std::array<const PixelShareLoss*, 3> parts = {&view.budget.covered, &view.budget.background,
+                                                        &view.budget.filled};
+    const std::array<PixelShareLoss*, 3> sums = {&mean.covered, &mean.background, &mean.filled};
+    for (size_t k = 0; k < 3; ++k) {
+      sums[k]->share += parts[k]->share;
+      sums[k]->db_lost += parts[k]->db_lost;
+      if (parts[k]->share > 0) {
+        sums[k]->psnr += parts[k]->psnr;
+        ++with_pixels[k];
+      }
+    }
+    mean.out_of_view_share += view.budget.out_of_view_share;
+    mean.exposure_db += view.budget.exposure_db;
+  }
+  if (views.empty()) return mean;
+  const auto n = static_cast<double>(views.size());
+  const std::array<PixelShareLoss*, 3> sums = {&mean.covered, &mean.background, &mean.filled};
+  for (size_t k = 0; k < 3; ++k) {
+    sums[k]->share /= n;
+    sums[k]->db_lost /= n;
+    if (with_pixels[k] > 0) sums[k]->psnr /= with_pixels[k];
+  }
+  mean.out_of_view_share /= n;
+  mean.exposure_db /= n;
+  return mean;
+}
+
 }  // namespace
 
 NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<NamedCamera>& targets,
@@ -82,16 +149,14 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
         truth_image.Channels() < 3) {
       throw BadInputError(truth_path.string() + ": not an RGB image of its camera's size");
     }
-    std::vector<uint8_t> sampled(view.result.classes.classes.size());
-    for (size_t p = 0; p < sampled.size(); ++p) {
-      const PixelClass c = view.result.classes.classes[p];
-      sampled[p] = c == PixelClass::kCovered || c == PixelClass::kBackground;
-    }
+    const std::vector<uint8_t> sampled =
+        MaskOf(view.result.classes, {PixelClass::kCovered, PixelClass::kBackground});
     const HoleMetrics& metrics = view.result.metrics;
     NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
                                Psnr(render, truth_image, sampled),
                                Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
                                metrics.hole_ratio, view.sources};
+    score.budget = BudgetOf(render, truth_image, view.result.classes, score.psnr, score.psnr_exposure_matched);
     evaluation.per_view.push_back(score);
     evaluation.psnr_mean += score.psnr;
     evaluation.ssim_mean += score.ssim;
@@ -120,6 +185,7 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
       *mean /= n;
     }
   }
+  evaluation.budget_mean = MeanBudget(evaluation.per_view);
   evaluation.sources_loaded = library.LoadedCount();
   evaluation.sources_total = static_cast<int>(library.Cameras().size());
   return evaluation;

@@ -10,6 +10,25 @@
 
 namespace parallax {
 
+// The pixels of one kind in a rendered view: their share of the frame, their PSNR (0 where
+// there are none) and the dB the whole frame's PSNR would gain were they exact.
+struct PixelShareLoss {
+  double share = 0;
+  double psnr = 0;
+  double db_lost = 0;
+};
+
+// Where a view's error comes from (docs/novel-views.md): the pixels warped surfaces covered,
+// those only background (sky) covered, and those the fill made (holes and out of view); and
+// what matching the render's exposure to the photo gains.
+struct LossBudget {
+  PixelShareLoss covered;
+  PixelShareLoss background;
+  PixelShareLoss filled;
+  double out_of_view_share = 0;  // Of the filled pixels, those no source saw at all.
+  double exposure_db = 0;        // Exposure-matched PSNR minus PSNR.
+};
+
 // One novel view's scores (as the means below).
 struct NovelViewScore {
   std::string name;
@@ -19,6 +38,7 @@ struct NovelViewScore {
   double psnr_exposure_matched = 0;
   double hole_ratio = 0;
   std::vector<std::string> sources;  // The views it was rendered from, best first.
+  LossBudget budget;
 };
 
 struct NovelEvaluation {
@@ -37,6 +57,8 @@ struct NovelEvaluation {
   double background_ratio_mean = 0;
   double hole_ratio_filled_mean = 0;
   double ms_per_view = 0;
+  // The views' budgets averaged (each class's PSNR over the views that have such pixels).
+  LossBudget budget_mean;
   int sources_loaded = 0;  // Source views read from disk, of `sources_total`.
   int sources_total = 0;
 };

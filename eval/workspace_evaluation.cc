@@ -52,6 +52,23 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
   return result;
 }
 
+// `targets` rendered from the sources (the workspace's, or with options.gt_sources the
+// scene's) and compared with the photos `names` in `truth`, into `evaluation`.
+void RenderAndCompare(const Workspace& workspace, ViewSetPaths sources, const std::vector<NamedCamera>& targets,
+                      const std::vector<std::string>& names, const ViewSetPaths& truth,
+                      const EvaluateOptions& options, NovelViewsEvaluation& evaluation) {
+  if (!options.novel.color_gains) sources.color_gains.clear();
+  evaluation.color_gains = !sources.color_gains.empty() && fs::exists(sources.color_gains);
+  SourceLibrary library(sources);
+  library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
+  if (!options.gt_sources) {
+    evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
+  }
+  evaluation.comparison_dir = EvaluationLayout(workspace.Root()).NovelComparisons(options.gt_sources);
+  evaluation.result = EvaluateNovelViews(library, targets, names, truth, options.novel.selection,
+                                         options.novel.render, evaluation.comparison_dir);
+}
+
 // The scene's novel cameras rendered from the workspace (cameras mapped into its frame) or,
 // with gt_sources, from the scene's own training views and depth; compared with the novel
 // images.
@@ -88,18 +105,8 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
     }
     if (evaluation.poses_registered > 0) evaluation.poses = "registered";
   }
-  ViewSetPaths source_paths = options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root());
-  if (!options.novel.color_gains) source_paths.color_gains.clear();
-  evaluation.color_gains = !source_paths.color_gains.empty() && fs::exists(source_paths.color_gains);
-  SourceLibrary library(source_paths);
-  library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
-  if (!options.gt_sources) {
-    evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
-  }
-  evaluation.comparison_dir = EvaluationLayout(workspace.Root()).NovelComparisons(options.gt_sources);
-  evaluation.result = EvaluateNovelViews(library, targets, names, scene.Novel(),
-                                         options.novel.selection, options.novel.render,
-                                         evaluation.comparison_dir);
+  RenderAndCompare(workspace, options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root()), targets,
+                   names, scene.Novel(), options, evaluation);
   return evaluation;
 }
 
@@ -154,9 +161,49 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
   return evaluation;
 }
 
+nlohmann::json BudgetJson(const LossBudget& budget) {
+  const auto part = [](const PixelShareLoss& loss) {
+    return nlohmann::json{{"share", loss.share}, {"psnr", loss.psnr}, {"db_lost", loss.db_lost}};
+  };
+  return {{"covered", part(budget.covered)},
+          {"background", part(budget.background)},
+          {"filled", part(budget.filled)},
+          {"out_of_view_share", budget.out_of_view_share},
+          {"exposure_db", budget.exposure_db}};
+}
+
+WorkspaceEvaluation EvaluateHeldOut(const Workspace& workspace, const EvaluateOptions& options) {
+  const Workspace held_out = workspace.HeldOut();
+  if (!DetectSparseFormat(held_out.Sparse())) {
+    throw BadInputError(workspace.Root().string() + " has no held-out photos (" + held_out.Sparse().string() +
+                        "): reconstruct it with --hold-out or --hold-out-photos, or give --gt");
+  }
+  if (!HasDepthMaps(workspace.DepthDir())) {
+    throw BadInputError(workspace.DepthDir().string() + " holds no depth maps to render the held-out photos from: "
+                        "reconstruct without --no-depth");
+  }
+  if (options.gt_sources) throw BadInputError("--gt-sources needs a scene folder with ground truth (--gt)");
+  const SparseModel model = ReadSparseModel(held_out.Sparse());
+  std::vector<NamedCamera> targets;
+  std::vector<std::string> names;
+  for (const SparseImage& image : model.Images()) {
+    targets.push_back({fs::path(image.name).stem().string(), {model.CameraById(image.camera_id), image.cam_from_world}});
+    names.push_back(image.name);
+  }
+  WorkspaceEvaluation evaluation;
+  evaluation.held_out = true;
+  NovelViewsEvaluation& novel = evaluation.novel.emplace();
+  novel.poses = "held out of the dense stages, registered with the others";
+  ViewSetPaths truth;
+  truth.images = held_out.Images();
+  RenderAndCompare(workspace, SourcePathsFor(workspace.Root()), targets, names, truth, options, novel);
+  evaluation.reconstruct_timings_s = ReconstructTimings(workspace);
+  return evaluation;
+}
+
 void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
   json = nlohmann::json::object();
-  AddPoseSections(evaluation.poses, json);
+  if (!evaluation.held_out) AddPoseSections(evaluation.poses, json);
   if (evaluation.depth) AddDepthSection(*evaluation.depth, json);
   if (evaluation.fused) {
     const CloudAccuracy& cloud = *evaluation.fused;
@@ -193,7 +240,8 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                      {"gt_sources", novel.gt_sources},
                      {"color_gains", novel.color_gains},
                      {"poses", novel.poses},
-                     {"poses_registered", novel.poses_registered}};
+                     {"poses_registered", novel.poses_registered},
+                     {"budget_mean", BudgetJson(result.budget_mean)}};
     nlohmann::json& per_view = json["novel"]["per_view"] = nlohmann::json::array();
     for (const NovelViewScore& view : result.per_view) {
       per_view.push_back({{"name", view.name},
@@ -202,7 +250,8 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                           {"psnr_valid", view.psnr_valid},
                           {"psnr_exposure_matched", view.psnr_exposure_matched},
                           {"hole_ratio", view.hole_ratio},
-                          {"sources", view.sources}});
+                          {"sources", view.sources},
+                          {"budget", BudgetJson(view.budget)}});
     }
   }
   if (!evaluation.not_scored.empty()) json["not_scored"] = evaluation.not_scored;

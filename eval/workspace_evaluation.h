@@ -61,6 +61,9 @@ struct NovelViewsEvaluation {
 };
 
 struct WorkspaceEvaluation {
+  // reconstruct --hold-out's protocol: the held-out photos scored, no ground truth (`poses`
+  // left empty).
+  bool held_out = false;
   PoseEvaluation poses;
   std::optional<DepthEvaluation> depth;  // Present when some depth map has ground truth.
   bool depth_aligned = true;
@@ -81,6 +84,12 @@ struct WorkspaceEvaluation {
 // ground-truth file cannot be read, ToolError when colmap fails to register held-out photos.
 WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFolder& scene,
                                       const EvaluateOptions& options, Progress& progress);
+
+// The photos `workspace` holds out (reconstruct --hold-out, Workspace::HeldOut) rendered at
+// their cameras from the workspace's sources and compared with them, as novel-view benchmarks
+// score real photos: no ground truth needed. Throws BadInputError when the workspace holds no
+// photos out or has no depth maps.
+WorkspaceEvaluation EvaluateHeldOut(const Workspace& workspace, const EvaluateOptions& options);
 
 // The JSON evaluate writes (docs/design.md "evaluation.json").
 void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation);

@@ -49,9 +49,13 @@ void CheckVocabularyTree(const fs::path& tree) {
   if (!std::ifstream(tree, std::ios::binary)) throw BadInputError(name + " cannot be read");
 }
 
-void FillModelStatistics(const SparseModel& model, const PhotoSet& photos,
+// `model`: the workspace's (undistorted) model; `held_out`: the registered photos held out of it.
+void FillModelStatistics(const SparseModel& model, const SparseModel& held_out, const PhotoSet& photos,
                          ReconstructSummary& summary) {
-  summary.images_registered = static_cast<int>(model.Images().size());
+  summary.images_registered = static_cast<int>(model.Images().size() + held_out.Images().size());
+  summary.held_out.clear();
+  for (const SparseImage& image : held_out.Images()) summary.held_out.push_back(image.name);
+  std::sort(summary.held_out.begin(), summary.held_out.end());
   summary.points3d = model.Points3D().size();
   double track_sum = 0, error_sum = 0;
   for (const Point3D& point : model.Points3D()) {
@@ -63,7 +67,9 @@ void FillModelStatistics(const SparseModel& model, const PhotoSet& photos,
   summary.mean_reprojection_error_px = error_sum / n;
   summary.unregistered.clear();
   for (const Photo& photo : photos.photos) {
-    if (!model.FindImageByName(photo.name)) summary.unregistered.push_back(photo.name);
+    if (!model.FindImageByName(photo.name) && !held_out.FindImageByName(photo.name)) {
+      summary.unregistered.push_back(photo.name);
+    }
   }
 }
 
@@ -83,6 +89,7 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
   return {{"images_found", summary.images_found},
           {"images_registered", summary.images_registered},
           {"unregistered", summary.unregistered},
+          {"held_out", summary.held_out},
           {"other_models", summary.other_models},
           {"points3d", summary.points3d},
           {"mean_track_length", summary.mean_track_length},
@@ -142,7 +149,7 @@ SparseModel CheckRawModel(const SfmContext& sfm, ReconstructSummary& summary) {
         " disconnected models; kept the largest (" + std::to_string(raw_model.Images().size()) +
         " images), the others are in " + paths.Models().string());
   }
-  FillModelStatistics(raw_model, sfm.photos, summary);
+  FillModelStatistics(raw_model, SparseModel(), sfm.photos, summary);
   const int num_images = static_cast<int>(sfm.photos.photos.size());
   const int required = std::max(2, (num_images + 1) / 2);
   if (summary.images_registered < required) {
@@ -281,7 +288,8 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   const Workspace paths(workspace);
   const SfmContext sfm{ReadablePhotosDir(photos_dir, photos, paths), photos, known ? &*known : nullptr, options, colmap,
                        paths, ChooseCameraSetup(photos, options, known ? &*known : nullptr),
-                       MatcherFor(options, num_images), progress};
+                       MatcherFor(options, num_images), progress,
+                       HeldOutPhotos(PhotoNames(photos), options.hold_out_every, options.hold_out_photos)};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = PlannedMatcher(options, num_images);
   if (!options.vocab_tree.empty() && sfm.matcher == MatcherChoice::kExhaustive) {
@@ -328,7 +336,14 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     graph.Run(undistort);
     undistort_key = undistort.key;
   }
-  FillModelStatistics(ReadSparseModel(sfm.workspace.Sparse()), photos, summary);
+  const Workspace held_out = sfm.workspace.HeldOut();
+  FillModelStatistics(ReadSparseModel(sfm.workspace.Sparse()),
+                      sfm.held_out.empty() ? SparseModel() : ReadSparseModel(held_out.Sparse()), photos, summary);
+  if (!sfm.held_out.empty()) {
+    summary.notes.push_back(std::to_string(summary.held_out.size()) + " of " + std::to_string(sfm.held_out.size()) +
+                            " held-out photos registered, kept out of the dense stages and the render sources: " +
+                            held_out.Root().string() + " (parallax evaluate scores them)");
+  }
   if (options.estimate_depth) RunDenseStages(sfm, undistort_key, graph, summary);
   summary.stages = graph.Records();
   WriteReport(sfm.workspace.Report(), summary);

@@ -93,6 +93,13 @@ struct ReconstructOptions {
   // The refinement is kept only if the principal point stays within this fraction of the
   // image size from the centre; further off it was not observable and drifted.
   double max_refined_principal_point_offset = 0.05;
+  // Photos held out of everything after structure from motion, as novel-view benchmarks hold
+  // them out: registered with the others, then kept out of the depth stage, fusion, the mesh,
+  // the color gains and the render sources, and written to Workspace::HeldOut for `evaluate`
+  // to render at their cameras and compare. Every n-th photo in name order from the first
+  // (0: none), and the photos named.
+  int hold_out_every = 0;
+  std::vector<std::string> hold_out_photos;
   PlausibilityOptions plausibility;
   // Run multi-view stereo after SfM (the depth stage, pipeline/dense_stages.h), at `quality`.
   bool estimate_depth = true;
@@ -120,6 +127,7 @@ struct ReconstructSummary {
   int images_found = 0;
   int images_registered = 0;
   std::vector<std::string> unregistered;  // Names of photos not in the model.
+  std::vector<std::string> held_out;      // Registered photos held out (Workspace::HeldOut).
   int other_models = 0;                   // Disconnected models besides the one kept.
   size_t points3d = 0;
   double mean_track_length = 0;

@@ -260,6 +260,23 @@ MapperPlan PlanKeyPhotos(const ReconstructOptions& options, int num_images,
               "; the other " + std::to_string(num_images - key_count) + " registered to it)" + chosen};
 }
 
+std::set<std::string> HeldOutPhotos(const std::vector<std::string>& names, int every,
+                                    const std::vector<std::string>& named) {
+  std::set<std::string> held_out;
+  for (size_t i = 0; every > 0 && i < names.size(); i += static_cast<size_t>(every)) held_out.insert(names[i]);
+  for (const std::string& name : named) {
+    if (std::find(names.begin(), names.end(), name) == names.end()) {
+      throw BadInputError("--hold-out-photos: " + name + " is not one of the photos");
+    }
+    held_out.insert(name);
+  }
+  if (!held_out.empty() && names.size() < held_out.size() + 2) {
+    throw BadInputError("holding out " + std::to_string(held_out.size()) + " of " + std::to_string(names.size()) +
+                        " photos leaves fewer than two to reconstruct from");
+  }
+  return held_out;
+}
+
 bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& options, int num_images) {
   return camera.sharing == CameraSharing::kAll && !camera.fixed_intrinsics &&
          num_images >= options.refine_principal_point_min_images;

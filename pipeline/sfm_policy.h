@@ -4,6 +4,7 @@
 // each quality asks of colmap, and report.json's sentences on them. Pure functions.
 #include <cstdint>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -119,6 +120,12 @@ KeyPhotoOptions KeyPhotoOptionsFor(const ReconstructOptions& options);
 // photo is a key, PlanByCount's plan, saying so.
 MapperPlan PlanKeyPhotos(const ReconstructOptions& options, int num_images,
                          std::optional<std::vector<std::string>> keys);
+
+// The photos held out (ReconstructOptions::hold_out_every, hold_out_photos) among `names` (in
+// name order): every `every`-th from the first, and those `named`. Throws BadInputError naming a
+// photo that is not among them, or when fewer than two photos would be left.
+std::set<std::string> HeldOutPhotos(const std::vector<std::string>& names, int every,
+                                    const std::vector<std::string>& named);
 
 // Whether the mapper ends with a bundle adjustment that frees the principal point: one shared
 // camera whose intrinsics are estimated, from `options.refine_principal_point_min_images`.

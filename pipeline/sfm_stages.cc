@@ -113,6 +113,17 @@ PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   return check;
 }
 
+// `model`'s cameras and images, without points and keypoints.
+SparseModel CamerasAndPoses(const SparseModel& model) {
+  SparseModel cameras;
+  for (const Camera& camera : model.Cameras()) cameras.AddCamera(camera);
+  for (SparseImage image : model.Images()) {
+    image.points2d.clear();
+    cameras.AddImage(std::move(image));
+  }
+  return cameras;
+}
+
 }  // namespace
 
 fs::path ReadablePhotosDir(const fs::path& photos_dir, const PhotoSet& photos,
@@ -389,10 +400,12 @@ Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
   Hasher hasher;
   hasher.Add(mapper_key);
   if (may_distort) hasher.Add("undistort-2");
+  for (const std::string& name : sfm.held_out) hasher.Add("held out").Add(name);
   Stage stage;
   stage.name = "undistort";
   stage.key = hasher.Hex();
   stage.outputs = {paths.Sparse()};
+  if (!sfm.held_out.empty()) stage.outputs.push_back(paths.HeldOut().Sparse());
   if (!raw_model) {
     stage.run = [] {};
     return stage;
@@ -409,11 +422,22 @@ Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
     stage.not_needed = "the cameras have no lens distortion: photos copied, not resampled "
                        "(colmap image_undistorter not needed)";
   }
+  if (!supported && !sfm.held_out.empty()) {
+    throw BadInputError("--hold-out needs a camera model parallax undistorts itself (not " +
+                        std::string(CameraModelName(raw_model->Cameras().front().model)) + ")");
+  }
   stage.run = [&sfm, raw_model, paths, supported] {
     const fs::path output = paths.UndistortScratch();
     RemoveAll(output);
+    const Workspace undistorted(output);
     if (supported) {
-      WritePinholeWorkspace(*raw_model, sfm.photos_dir, output);
+      // The held-out photos' cameras beside, without the points (evaluate renders them).
+      WritePinholeWorkspace(SelectImages(*raw_model, sfm.held_out, false), sfm.photos_dir, output);
+      if (!sfm.held_out.empty()) {
+        WritePinholeWorkspace(CamerasAndPoses(SelectImages(*raw_model, sfm.held_out, true)), sfm.photos_dir,
+                              undistorted.HeldOut().Root());
+        RemoveAll(undistorted.HeldOut().Stereo());
+      }
     } else {
       sfm.colmap.Run("image_undistorter",
                      {"--image_path", sfm.photos_dir.string(), "--input_path",
@@ -422,10 +446,14 @@ Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
                      paths.Log("undistort"), "undistort",
                      static_cast<int>(sfm.photos.photos.size()), sfm.progress);
     }
-    const Workspace undistorted(output);
     ReplaceFolder(undistorted.Images(), paths.Images());
     ReplaceFolder(undistorted.Stereo(), paths.Stereo());
     ReplaceFolder(undistorted.Sparse(), paths.Sparse());
+    if (fs::exists(undistorted.HeldOut().Root())) {
+      ReplaceFolder(undistorted.HeldOut().Root(), paths.HeldOut().Root());
+    } else {
+      RemoveAll(paths.HeldOut().Root());
+    }
     RemoveAll(output);
   };
   return stage;

@@ -4,6 +4,7 @@
 // the one before it. Their decisions are pipeline/sfm_policy.h's; the colmap commands on the
 // mapper's models are colmap/raw_model.h's.
 #include <filesystem>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,7 @@ struct SfmContext {
   // MatcherFor: kAuto only past the exhaustive limit, where the capture's order decides.
   MatcherChoice matcher;
   Progress& progress;
+  std::set<std::string> held_out;  // HeldOutPhotos.
 };
 
 // The plan for the photos of `sfm`. Key photos are chosen from the verified matches, so they

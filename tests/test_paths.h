@@ -10,6 +10,10 @@ namespace parallax {
 // The repository's root folder.
 std::filesystem::path SourceDir();
 
+// The real photos beside the repository (../shared/datasets, docs/design.md); tests that use
+// them skip where the folder is absent.
+std::filesystem::path SharedDatasets();
+
 // The built `parallax` executable.
 std::string ParallaxExecutable();
 

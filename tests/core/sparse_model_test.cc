@@ -305,6 +305,29 @@ TEST(SparseModel, WithoutKeypointsKeepsCamerasPosesAndTracks) {
   }
 }
 
+TEST(SparseModel, SelectImagesKeepsTheirCamerasAndThePointsTwoOfThemSee) {
+  const SparseModel model = MakeModel();
+  const SparseModel without_d = SelectImages(model, {"d.jpg"}, false);
+  std::vector<std::string> names;
+  for (const SparseImage& image : without_d.Images()) names.push_back(image.name);
+  EXPECT_EQ(names, std::vector<std::string>({"dir/b.png", "a.jpg", "c.jpg"}));
+  EXPECT_EQ(without_d.Cameras().size(), 3u);
+  // Point 1 loses d.jpg's observation; kBigPointId, seen by b.png alone, and 10, by d.jpg, go.
+  std::vector<uint64_t> ids;
+  for (const Point3D& point : without_d.Points3D()) ids.push_back(point.id);
+  EXPECT_EQ(ids, std::vector<uint64_t>({4, 1}));
+  EXPECT_EQ(without_d.Point3DById(1).track.size(), 2u);
+  EXPECT_EQ(without_d.ImageById(2).points2d.size(), 4u);
+  EXPECT_EQ(without_d.ImageById(2).points2d[3].point3d_id, kInvalidPoint3DId);
+  EXPECT_EQ(without_d.ImageById(2).points2d[0].point3d_id, 4u);
+
+  const SparseModel c_and_d = SelectImages(model, {"c.jpg", "d.jpg"}, true);
+  EXPECT_EQ(c_and_d.Images().size(), 2u);
+  EXPECT_EQ(c_and_d.Cameras().size(), 2u);  // 7 and 1.
+  EXPECT_TRUE(c_and_d.Points3D().empty());
+  for (const Point2D& point : c_and_d.ImageById(9).points2d) EXPECT_EQ(point.point3d_id, kInvalidPoint3DId);
+}
+
 TEST(SparseModel, DetectsTheFormatFromTheFilesPresent) {
   const TempDir dir;
   EXPECT_EQ(DetectSparseFormat(dir / "model"), std::nullopt);

@@ -3,6 +3,7 @@
 #include "pipeline/sfm_policy.h"
 
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -198,6 +199,16 @@ TEST(RefinesPrincipalPoint, OnlyOneSharedEstimatedCameraFromTheMinimumPhotoCount
   EXPECT_FALSE(RefinesPrincipalPoint({CameraModel::kSimpleRadial, "", CameraSharing::kPerGroup, false}, options, 50));
   EXPECT_FALSE(RefinesPrincipalPoint({CameraModel::kSimplePinhole, "500,320,240", CameraSharing::kAll, true}, options,
                                      50));
+}
+
+TEST(HeldOutPhotos, EveryNthFromTheFirstAndTheNamedOnes) {
+  const std::vector<std::string> names = {"a", "b", "c", "d", "e", "f", "g", "h", "i"};
+  EXPECT_EQ(HeldOutPhotos(names, 0, {}), std::set<std::string>());
+  EXPECT_EQ(HeldOutPhotos(names, 4, {}), std::set<std::string>({"a", "e", "i"}));
+  EXPECT_EQ(HeldOutPhotos(names, 8, {"c"}), std::set<std::string>({"a", "c", "i"}));
+  EXPECT_THROW(HeldOutPhotos(names, 0, {"z"}), BadInputError);
+  EXPECT_EQ(HeldOutPhotos(names, 0, {"a", "b", "c", "d", "e", "f", "g"}).size(), 7u);  // Two are left.
+  EXPECT_THROW(HeldOutPhotos(names, 0, {"a", "b", "c", "d", "e", "f", "g", "h"}), BadInputError);
 }
 
 TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitIsRejected) {

@@ -1,0 +1,153 @@
+// The novel-view benchmarks' protocol on a bare photo folder: `reconstruct --hold-out` registers
+// every photo, keeps the held-out ones out of the dense stages, and `evaluate` (no ground
+// truth) renders their cameras and scores them with a loss budget per view.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/sparse_model.h"
+#include "core/workspace.h"
+#include "tests/cli_runner.h"
+#include "tests/temp_dir.h"
+#include "tests/test_paths.h"
+
+namespace parallax {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSmall = SourceDir() / "example_images" / "small";
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream file(path);
+  return nlohmann::json::parse(file);
+}
+
+std::vector<std::string> ImageNames(const fs::path& model) {
+  std::vector<std::string> names;
+  for (const SparseImage& image : ReadSparseModel(model).Images()) names.push_back(image.name);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+CliResult Reconstruct(const fs::path& photos, const fs::path& workspace, const std::string& flags) {
+  return RunParallax("reconstruct " + Quote(photos.string()) + " " + Quote(workspace.string()) + " " + flags);
+}
+
+// The budget accounts for the whole frame: the shares sum to one, and the frame's mean squared
+// error is the shares' weighted sum of theirs.
+void ExpectBudgetAddsUp(const nlohmann::json& view) {
+  const nlohmann::json& budget = view["budget"];
+  double share = 0, mse = 0;
+  for (const char* part : {"covered", "background", "filled"}) {
+    const double part_share = budget[part]["share"];
+    share += part_share;
+    if (part_share > 0) mse += part_share * std::pow(10.0, -budget[part]["psnr"].get<double>() / 10);
+  }
+  EXPECT_NEAR(share, 1.0, 1e-9) << view.dump();
+  EXPECT_NEAR(-10 * std::log10(mse), view["psnr"].get<double>(), 0.01) << view.dump();
+  EXPECT_NEAR(budget["exposure_db"].get<double>(),
+              view["psnr_exposure_matched"].get<double>() - view["psnr"].get<double>(), 1e-9);
+}
+
+// The small scene's 12 photos and its 4 novel ones in one folder, the novel ones held out.
+TEST(HeldOut, HeldOutPhotosAreRegisteredKeptOutOfTheDenseStagesAndScored) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  std::string named;
+  for (const fs::path& folder : {kSmall / "images", kSmall / "novel" / "images"}) {
+    for (const auto& entry : fs::directory_iterator(folder)) fs::copy_file(entry.path(), photos / entry.path().filename());
+  }
+  const std::vector<std::string> novel = {"novel_0000.png", "novel_0001.png", "novel_0002.png", "novel_0003.png"};
+  for (const std::string& name : novel) named += (named.empty() ? "" : ",") + name;
+
+  const fs::path held_out = dir.Path() / "held out";
+  const CliResult reconstructed = Reconstruct(photos, held_out, "--quality fast --hold-out-photos " + named);
+  ASSERT_EQ(reconstructed.exit_code, 0) << reconstructed.output;
+  EXPECT_NE(reconstructed.output.find("4 of 4 held-out photos registered"), std::string::npos) << reconstructed.output;
+  const Workspace workspace(held_out);
+  EXPECT_EQ(ReadJson(workspace.Report())["reconstruct"]["held_out"].get<std::vector<std::string>>(), novel);
+  EXPECT_EQ(ReadJson(workspace.Report())["reconstruct"]["images_registered"], 16);
+  EXPECT_EQ(ImageNames(workspace.HeldOut().Sparse()), novel);
+  EXPECT_EQ(ImageNames(workspace.Sparse()).size(), 12u);
+  for (const std::string& name : novel) {
+    EXPECT_TRUE(fs::exists(workspace.HeldOut().Images() / name)) << name;
+    EXPECT_FALSE(fs::exists(workspace.Images() / name)) << name;
+    EXPECT_FALSE(fs::exists(workspace.Depth(name))) << name;
+  }
+  const CliResult evaluated = RunParallax("evaluate " + Quote(held_out.string()));
+  ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;
+  EXPECT_NE(evaluated.output.find("loss budget"), std::string::npos) << evaluated.output;
+  const nlohmann::json scores = ReadJson(workspace.Root() / "evaluation.json")["novel"];
+  EXPECT_EQ(scores["views"], 4);
+  for (const nlohmann::json& view : scores["per_view"]) ExpectBudgetAddsUp(view);
+
+}
+
+// The scene's cameras, its 12 training photos' and its 4 novel ones', in one model.
+SparseModel EveryGroundTruthCamera() {
+  SparseModel model = ReadSparseModel(kSmall / "gt" / "sparse");
+  const SparseModel novel = ReadSparseModel(kSmall / "novel" / "sparse");
+  for (SparseImage image : novel.Images()) {
+    EXPECT_EQ(novel.CameraById(image.camera_id).params, model.CameraById(image.camera_id).params);
+    image.id += 100;
+    model.AddImage(std::move(image));
+  }
+  return model;
+}
+
+// With the ground-truth cameras known, the held-out protocol and the scene folder's (its
+// cameras taken as they are) render the same views from the same sources: the same scores.
+TEST(HeldOut, AtTheSameCamerasBothProtocolsScoreTheSame) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos", known = dir.Path() / "known", workspace = dir.Path() / "ws";
+  fs::create_directories(photos);
+  for (const fs::path& folder : {kSmall / "images", kSmall / "novel" / "images"}) {
+    for (const auto& entry : fs::directory_iterator(folder)) fs::copy_file(entry.path(), photos / entry.path().filename());
+  }
+  WriteSparseModel(EveryGroundTruthCamera(), known, SparseFormat::kText);
+  const CliResult reconstructed =
+      Reconstruct(photos, workspace,
+                  "--quality fast --known-cameras " + Quote(known.string()) +
+                      " --hold-out-photos novel_0000.png,novel_0001.png,novel_0002.png,novel_0003.png");
+  ASSERT_EQ(reconstructed.exit_code, 0) << reconstructed.output;
+  ASSERT_EQ(RunParallax("evaluate " + Quote(workspace.string())).exit_code, 0);
+  const CliResult scene = RunParallax("evaluate " + Quote(workspace.string()) + " --gt " + Quote(kSmall.string()) +
+                                      " --no-align --novel-only --novel-poses aligned --json " +
+                                      Quote((dir.Path() / "scene.json").string()));
+  ASSERT_EQ(scene.exit_code, 0) << scene.output;
+  const nlohmann::json held_out = ReadJson(workspace / "evaluation.json")["novel"];
+  const nlohmann::json scene_scores = ReadJson(dir.Path() / "scene.json")["novel"];
+  std::printf("[ measure ] held out %.3f dB, SSIM %.4f; scene protocol %.3f dB, SSIM %.4f\n",
+              held_out["psnr_mean"].get<double>(), held_out["ssim_mean"].get<double>(),
+              scene_scores["psnr_mean"].get<double>(), scene_scores["ssim_mean"].get<double>());
+  EXPECT_EQ(held_out["views"], 4);
+  EXPECT_NEAR(held_out["psnr_mean"].get<double>(), scene_scores["psnr_mean"].get<double>(), 0.01);
+  EXPECT_NEAR(held_out["ssim_mean"].get<double>(), scene_scores["ssim_mean"].get<double>(), 0.0005);
+}
+
+TEST(HeldOut, UnknownPhotosAndWorkspacesWithoutHeldOutPhotosExitTwo) {
+  const TempDir dir;
+  const CliResult unknown = Reconstruct(kSmall / "images", dir.Path() / "ws", "--hold-out-photos nope.png");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+  EXPECT_NE(unknown.output.find("--hold-out-photos: nope.png is not one of the photos"), std::string::npos)
+      << unknown.output;
+  const CliResult too_many = Reconstruct(kSmall / "images", dir.Path() / "ws", "--hold-out 2 --dry-run");
+  EXPECT_EQ(too_many.exit_code, 0) << too_many.output;  // 6 of 12: six are left.
+  const CliResult usage = Reconstruct(kSmall / "images", dir.Path() / "ws", "--hold-out 1");
+  EXPECT_EQ(usage.exit_code, 1) << usage.output;
+  fs::create_directories(dir.Path() / "empty" / "sparse");
+  const CliResult nothing_held = RunParallax("evaluate " + Quote((dir.Path() / "empty").string()));
+  EXPECT_EQ(nothing_held.exit_code, 2) << nothing_held.output;
+  EXPECT_NE(nothing_held.output.find("has no held-out photos"), std::string::npos) << nothing_held.output;
+}
+
+}  // namespace
+}  // namespace parallax
