@@ -113,22 +113,44 @@ SparseModel LargestModel(const std::vector<fs::path>& dirs) {
   return best;
 }
 
-SparseModel RunOnRawModel(const Colmap& colmap, const Workspace& paths, const std::string& command,
-                          std::vector<std::string> arguments, const std::string& log_name, int total,
-                          Progress& progress) {
+namespace {
+
+// The model colmap `command` writes from the model in `input`, through
+// Workspace::RefinedModelScratch.
+SparseModel RunOnModel(const Colmap& colmap, const Workspace& paths, const fs::path& input,
+                       const std::string& command, std::vector<std::string> arguments, const std::string& log_name,
+                       int total, Progress& progress) {
   const fs::path output = paths.RefinedModelScratch();
   RemoveAll(output);
   fs::create_directories(output);
-  arguments.insert(arguments.end(), {"--input_path", paths.RawModel().string(), "--output_path", output.string()});
+  arguments.insert(arguments.end(), {"--input_path", input.string(), "--output_path", output.string()});
   colmap.Run(command, arguments, paths.Log(log_name), log_name, total, progress);
   SparseModel model = ReadSparseModel(output);
   RemoveAll(output);
   return model;
 }
 
+}  // namespace
+
+SparseModel RunOnRawModel(const Colmap& colmap, const Workspace& paths, const std::string& command,
+                          std::vector<std::string> arguments, const std::string& log_name, int total,
+                          Progress& progress) {
+  return RunOnModel(colmap, paths, paths.RawModel(), command, std::move(arguments), log_name, total, progress);
+}
+
 SparseModel AdjustRawModel(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,
                            const std::string& log_name, Progress& progress) {
   return RunOnRawModel(colmap, paths, "bundle_adjuster", options, log_name, 0, progress);
+}
+
+SparseModel AdjustModel(const Colmap& colmap, const Workspace& paths, const SparseModel& model,
+                        const std::vector<std::string>& options, const std::string& log_name, Progress& progress) {
+  const fs::path input = paths.PartialModelScratch();
+  RemoveAll(input);
+  WriteSparseModel(model, input, SparseFormat::kBinary);
+  SparseModel adjusted = RunOnModel(colmap, paths, input, "bundle_adjuster", options, log_name, 0, progress);
+  RemoveAll(input);
+  return adjusted;
 }
 
 SparseModel RegisterOtherPhotos(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,

@@ -68,6 +68,11 @@ SparseModel RunOnRawModel(const Colmap& colmap, const Workspace& paths, const st
 SparseModel AdjustRawModel(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,
                            const std::string& log_name, Progress& progress);
 
+// `model` after one colmap bundle_adjuster run with `options`, through
+// Workspace::PartialModelScratch (removed afterwards).
+SparseModel AdjustModel(const Colmap& colmap, const Workspace& paths, const SparseModel& model,
+                        const std::vector<std::string>& options, const std::string& log_name, Progress& progress);
+
 // The raw model with every other photo the database can place registered to its points (colmap
 // image_registrator with `options`: each photo's pose from its matches with the model's
 // points; no points are added and the model is not adjusted). The raw model is left as it was.

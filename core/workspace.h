@@ -58,6 +58,8 @@ class Workspace {
   std::filesystem::path MatchedMarker() const { return Sfm() / "matched"; }
   std::filesystem::path VocabularyTree() const { return Sfm() / "vocab_tree.bin"; }
   std::filesystem::path RefinedModelScratch() const { return Sfm() / "refined.tmp"; }
+  // A part of the raw model adjusted apart (the principal point's check, pipeline/sfm_policy.h).
+  std::filesystem::path PartialModelScratch() const { return Sfm() / "partial.tmp"; }
 
   // Depth maps at each photo's size: depth/<stem>.exr and depth/<stem>.confidence.exr.
   std::filesystem::path DepthDir() const { return root_ / "depth"; }

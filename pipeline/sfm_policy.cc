@@ -282,25 +282,68 @@ bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& 
          num_images >= options.refine_principal_point_min_images;
 }
 
-PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const ReconstructOptions& options) {
-  // Where the principal point is unobservable (a narrow arc of small images) it drifts far off
-  // and the rotations with it.
-  double worst_offset = 0;
+SparseModel HalfOfThePoints(const SparseModel& model, int parity) {
+  SparseModel half;
+  for (const Camera& camera : model.Cameras()) half.AddCamera(camera);
+  std::set<uint64_t> kept;
+  for (size_t i = static_cast<size_t>(parity); i < model.Points3D().size(); i += 2) {
+    half.AddPoint3D(model.Points3D()[i]);
+    kept.insert(model.Points3D()[i].id);
+  }
+  for (SparseImage image : model.Images()) {
+    for (Point2D& point : image.points2d) {
+      if (!kept.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
+    }
+    half.AddImage(std::move(image));
+  }
+  return half;
+}
+
+namespace {
+
+Eigen::Vector2d PrincipalPoint(const Camera& camera) { return {camera.PrincipalX(), camera.PrincipalY()}; }
+
+Eigen::Vector2d ImageCentre(const Camera& camera) {
+  return {0.5 * static_cast<double>(camera.width), 0.5 * static_cast<double>(camera.height)};
+}
+
+}  // namespace
+
+PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::array<SparseModel, 2>& halves,
+                                               const ReconstructOptions& options) {
+  // The camera farthest off-centre, and the one whose offset is least certain, in pixels.
+  double worst_offset = 0, offset_px = 0, deviation_px = 0, least_significance = HUGE_VAL;
   for (const Camera& camera : refined.Cameras()) {
     worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
+    const double offset = (PrincipalPoint(camera) - ImageCentre(camera)).norm();
+    const double deviation = 0.5 * (PrincipalPoint(halves[0].CameraById(camera.id)) -
+                                    PrincipalPoint(halves[1].CameraById(camera.id))).norm();
+    const double significance = offset / std::max(deviation, 1e-9);
+    if (significance < least_significance) {
+      least_significance = significance;
+      offset_px = offset;
+      deviation_px = deviation;
+    }
   }
-  char note[160];
-  const bool keep = !(worst_offset > options.max_refined_principal_point_offset);
-  if (!keep) {
+  char note[240];
+  if (worst_offset > options.max_refined_principal_point_offset) {
     std::snprintf(note, sizeof(note),
-                  "principal point refinement rejected: it drifted %.1f%% of the image size "
+                  "principal point kept at the image centre: the refined one drifted %.1f%% of the image size "
                   "off-centre (not observable in these photos)", 100 * worst_offset);
-  } else {
-    std::snprintf(note, sizeof(note),
-                  "principal point refined in a final bundle adjustment (%.1f%% off-centre)",
-                  100 * worst_offset);
+    return {false, note};
   }
-  return {keep, note};
+  if (least_significance < 3) {
+    std::snprintf(note, sizeof(note),
+                  "principal point kept at the image centre: the refined one, %.1f px off it, is within three "
+                  "standard deviations of its estimate (%.1f px, from two halves of the points)",
+                  offset_px, deviation_px);
+    return {false, note};
+  }
+  std::snprintf(note, sizeof(note),
+                "principal point refined in a final bundle adjustment: %.1f%% off-centre, %.1f standard "
+                "deviations of its estimate (%.1f px, from two halves of the points)",
+                100 * worst_offset, least_significance, deviation_px);
+  return {true, note};
 }
 
 }  // namespace parallax

@@ -211,28 +211,83 @@ TEST(HeldOutPhotos, EveryNthFromTheFirstAndTheNamedOnes) {
   EXPECT_THROW(HeldOutPhotos(names, 0, {"a", "b", "c", "d", "e", "f", "g", "h"}), BadInputError);
 }
 
-TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitIsRejected) {
-  ReconstructOptions options;
-  options.max_refined_principal_point_offset = 0.05;
+// A model of one 1000x500 camera whose principal point is at (x, y).
+SparseModel OneCameraAt(double x, double y) {
   Camera camera;
   camera.id = 1;
   camera.model = CameraModel::kSimpleRadial;
   camera.width = 1000;
   camera.height = 500;
-  camera.params = {800, 540, 250, 0};  // 4% of the width off-centre.
+  camera.params = {800, x, y, 0};
   SparseModel model;
   model.AddCamera(camera);
-  const PrincipalPointCheck kept = CheckRefinedPrincipalPoint(model, options);
+  return model;
+}
+
+TEST(CheckRefinedPrincipalPoint, APointMeasurablyOffCentreIsKept) {
+  const ReconstructOptions options;
+  // 40 px off; the halves 4 px apart: 2 px standard deviation, 20 of them.
+  const PrincipalPointCheck kept =
+      CheckRefinedPrincipalPoint(OneCameraAt(540, 250), {OneCameraAt(538, 250), OneCameraAt(542, 250)}, options);
   EXPECT_TRUE(kept.keep);
-  EXPECT_EQ(kept.note, "principal point refined in a final bundle adjustment (4.0% off-centre)");
-  camera.id = 2;
-  camera.params = {800, 500, 290, 0};  // 8% of the height off-centre.
-  model.AddCamera(camera);
-  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(model, options);
+  EXPECT_EQ(kept.note,
+            "principal point refined in a final bundle adjustment: 4.0% off-centre, 20.0 standard deviations "
+            "of its estimate (2.0 px, from two halves of the points)");
+}
+
+// As on 10 photos of a consumer camera undistorted to a centred pinhole: 2.9% off, but the
+// halves of the points disagree by more than that.
+TEST(CheckRefinedPrincipalPoint, APointTheHalvesDisagreeOnStaysAtTheCentre) {
+  const ReconstructOptions options;
+  const PrincipalPointCheck rejected =
+      CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(490, 250), OneCameraAt(570, 250)}, options);
   EXPECT_FALSE(rejected.keep);
   EXPECT_EQ(rejected.note,
-            "principal point refinement rejected: it drifted 8.0% of the image size off-centre (not "
-            "observable in these photos)");
+            "principal point kept at the image centre: the refined one, 29.0 px off it, is within three standard "
+            "deviations of its estimate (40.0 px, from two halves of the points)");
+  // Just past three standard deviations (9.5 px each): kept.
+  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(519.5, 250), OneCameraAt(538.5, 250)},
+                                         options).keep);
+}
+
+TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitStaysAtTheCentre) {
+  ReconstructOptions options;
+  options.max_refined_principal_point_offset = 0.05;
+  const SparseModel drifted = OneCameraAt(500, 290);  // 8% of the height off-centre.
+  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(drifted, {drifted, drifted}, options);
+  EXPECT_FALSE(rejected.keep);
+  EXPECT_EQ(rejected.note,
+            "principal point kept at the image centre: the refined one drifted 8.0% of the image size off-centre "
+            "(not observable in these photos)");
+}
+
+TEST(HalfOfThePoints, EveryOtherPointAndOnlyItsObservations) {
+  SparseModel model = OneCameraAt(500, 250);
+  SparseImage image;
+  image.id = 7;
+  image.camera_id = 1;
+  image.name = "a.png";
+  for (uint64_t id = 10; id < 15; ++id) {
+    Point3D point;
+    point.id = id;
+    point.track = {{7, static_cast<uint32_t>(image.points2d.size())}};
+    image.points2d.push_back({Eigen::Vector2d(static_cast<double>(id), 0), id});
+    model.AddPoint3D(point);
+  }
+  image.points2d.push_back({Eigen::Vector2d(1, 1), kInvalidPoint3DId});
+  model.AddImage(image);
+  for (int parity : {0, 1}) {
+    const SparseModel half = HalfOfThePoints(model, parity);
+    std::vector<uint64_t> ids, observed;
+    for (const Point3D& point : half.Points3D()) ids.push_back(point.id);
+    for (const Point2D& point : half.ImageById(7).points2d) {
+      if (point.point3d_id != kInvalidPoint3DId) observed.push_back(point.point3d_id);
+    }
+    EXPECT_EQ(ids, parity == 0 ? std::vector<uint64_t>({10, 12, 14}) : std::vector<uint64_t>({11, 13}));
+    EXPECT_EQ(observed, ids);
+    EXPECT_EQ(half.ImageById(7).points2d.size(), 6u);  // Keypoints stay, for colmap's ids.
+    EXPECT_EQ(half.Cameras().size(), 1u);
+  }
 }
 
 }  // namespace
