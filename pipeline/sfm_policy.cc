@@ -282,21 +282,21 @@ bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& 
          num_images >= options.refine_principal_point_min_images;
 }
 
-SparseModel HalfOfThePoints(const SparseModel& model, int parity) {
-  SparseModel half;
-  for (const Camera& camera : model.Cameras()) half.AddCamera(camera);
+SparseModel PartOfThePoints(const SparseModel& model, int part, int parts) {
+  SparseModel selected;
+  for (const Camera& camera : model.Cameras()) selected.AddCamera(camera);
   std::set<uint64_t> kept;
-  for (size_t i = static_cast<size_t>(parity); i < model.Points3D().size(); i += 2) {
-    half.AddPoint3D(model.Points3D()[i]);
+  for (size_t i = static_cast<size_t>(part); i < model.Points3D().size(); i += static_cast<size_t>(parts)) {
+    selected.AddPoint3D(model.Points3D()[i]);
     kept.insert(model.Points3D()[i].id);
   }
   for (SparseImage image : model.Images()) {
     for (Point2D& point : image.points2d) {
       if (!kept.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
     }
-    half.AddImage(std::move(image));
+    selected.AddImage(std::move(image));
   }
-  return half;
+  return selected;
 }
 
 namespace {
@@ -307,17 +307,29 @@ Eigen::Vector2d ImageCentre(const Camera& camera) {
   return {0.5 * static_cast<double>(camera.width), 0.5 * static_cast<double>(camera.height)};
 }
 
+// The standard deviation of `camera`'s refined principal point (pixels, per axis), from its
+// scatter over `parts`: a part's estimate has parts.size() times the whole's variance.
+double PrincipalPointDeviation(const Camera& camera, const std::vector<SparseModel>& parts) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const SparseModel& part : parts) mean += PrincipalPoint(part.CameraById(camera.id));
+  mean /= static_cast<double>(parts.size());
+  double squares = 0;
+  for (const SparseModel& part : parts) squares += (PrincipalPoint(part.CameraById(camera.id)) - mean).squaredNorm();
+  const double k = static_cast<double>(parts.size());
+  return std::sqrt(squares / (2 * (k - 1)) / k);
+}
+
 }  // namespace
 
-PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::array<SparseModel, 2>& halves,
+PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<SparseModel>& parts,
                                                const ReconstructOptions& options) {
+  if (parts.size() < 2) throw std::invalid_argument("CheckRefinedPrincipalPoint needs two parts or more");
   // The camera farthest off-centre, and the one whose offset is least certain, in pixels.
   double worst_offset = 0, offset_px = 0, deviation_px = 0, least_significance = HUGE_VAL;
   for (const Camera& camera : refined.Cameras()) {
     worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
     const double offset = (PrincipalPoint(camera) - ImageCentre(camera)).norm();
-    const double deviation = 0.5 * (PrincipalPoint(halves[0].CameraById(camera.id)) -
-                                    PrincipalPoint(halves[1].CameraById(camera.id))).norm();
+    const double deviation = PrincipalPointDeviation(camera, parts);
     const double significance = offset / std::max(deviation, 1e-9);
     if (significance < least_significance) {
       least_significance = significance;
@@ -335,14 +347,14 @@ PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const
   if (least_significance < 3) {
     std::snprintf(note, sizeof(note),
                   "principal point kept at the image centre: the refined one, %.1f px off it, is within three "
-                  "standard deviations of its estimate (%.1f px, from two halves of the points)",
-                  offset_px, deviation_px);
+                  "standard deviations of its estimate (%.1f px, from %d parts of the points)",
+                  offset_px, deviation_px, static_cast<int>(parts.size()));
     return {false, note};
   }
   std::snprintf(note, sizeof(note),
                 "principal point refined in a final bundle adjustment: %.1f%% off-centre, %.1f standard "
-                "deviations of its estimate (%.1f px, from two halves of the points)",
-                100 * worst_offset, least_significance, deviation_px);
+                "deviations of its estimate (%.1f px, from %d parts of the points)",
+                100 * worst_offset, least_significance, deviation_px, static_cast<int>(parts.size()));
   return {true, note};
 }
 

@@ -2,7 +2,6 @@
 // The decisions of the structure-from-motion stages (pipeline/sfm_stages.h) that need neither
 // colmap nor files: the camera setup, the extraction runs, the matcher, the mapper plan, what
 // each quality asks of colmap, and report.json's sentences on them. Pure functions.
-#include <array>
 #include <cstdint>
 #include <optional>
 #include <set>
@@ -132,23 +131,27 @@ std::set<std::string> HeldOutPhotos(const std::vector<std::string>& names, int e
 // camera whose intrinsics are estimated, from `options.refine_principal_point_min_images`.
 bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& options, int num_images);
 
-// `model` with every other point, from the `parity`-th (0 or 1): the others and their
-// observations removed. The principal point refined on each half of the points says how well
-// the photos determine it.
-SparseModel HalfOfThePoints(const SparseModel& model, int parity);
+// How many parts of the points the principal point is refined on apart, to measure how well the
+// photos determine it.
+inline constexpr int kPrincipalPointParts = 4;
+
+// `model` with every `parts`-th point from the `part`-th: the others and their observations
+// removed.
+SparseModel PartOfThePoints(const SparseModel& model, int part, int parts);
 
 // Whether a model whose principal points were refined is kept, and report.json's note saying
 // which and why. Kept where every camera's refined principal point is within
 // `options.max_refined_principal_point_offset` of the image centre and measurably off it:
-// farther from the centre than three standard deviations of its estimate, which the refinements
-// on the two halves of the points (`halves`, HalfOfThePoints) give: they lie 2 sigma apart on
-// average. Otherwise the centre stays, as COLMAP keeps it by default: a few photos of a facade
-// cannot tell a shifted principal point from a turned camera.
+// farther from the centre than three standard deviations of its estimate. The refinements on
+// disjoint parts of the points (`parts`, PartOfThePoints) give the deviation: with 1/K of the
+// points each, they scatter sqrt(K) times as widely. Otherwise the centre stays, as COLMAP keeps
+// it by default: a few photos of a facade cannot tell a shifted principal point from a turned
+// camera.
 struct PrincipalPointCheck {
   bool keep = false;
   std::string note;
 };
-PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::array<SparseModel, 2>& halves,
+PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<SparseModel>& parts,
                                                const ReconstructOptions& options);
 
 }  // namespace parallax

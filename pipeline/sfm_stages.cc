@@ -104,16 +104,18 @@ std::string ImageListText(const std::vector<std::string>& names) {
 }
 
 // A final bundle adjustment that also frees the principal point, written over the raw model
-// only where CheckRefinedPrincipalPoint keeps it, after the same adjustment of each half of the
-// points; returns the check (keep, report.json's note).
+// only where CheckRefinedPrincipalPoint keeps it, after the same adjustment of each of
+// kPrincipalPointParts parts of the points; returns the check (keep, report.json's note).
 PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   const std::vector<std::string> refine = {"--BundleAdjustment.refine_principal_point", "1"};
   const SparseModel model = AdjustRawModel(sfm.colmap, sfm.workspace, refine, "refine", sfm.progress);
   const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
-  const std::array<SparseModel, 2> halves = {
-      AdjustModel(sfm.colmap, sfm.workspace, HalfOfThePoints(raw, 0), refine, "refine_half", sfm.progress),
-      AdjustModel(sfm.colmap, sfm.workspace, HalfOfThePoints(raw, 1), refine, "refine_half", sfm.progress)};
-  const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, halves, sfm.options);
+  std::vector<SparseModel> parts;
+  for (int part = 0; part < kPrincipalPointParts; ++part) {
+    parts.push_back(AdjustModel(sfm.colmap, sfm.workspace, PartOfThePoints(raw, part, kPrincipalPointParts), refine,
+                                "refine_part", sfm.progress));
+  }
+  const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, parts, sfm.options);
   if (check.keep) WriteSparseModel(model, sfm.workspace.RawModel(), SparseFormat::kBinary);
   return check;
 }
@@ -333,7 +335,7 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
   hasher.Add(matches_key)
       .Add(sfm.camera.fixed_intrinsics)
       .Add(refine_principal_point)
-      .Add(refine_principal_point ? "checked on two halves of the points" : "")
+      .Add(refine_principal_point ? "checked on parts of the points" : "")
       .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
   // The incremental mapper keeps the keys it had before there was a choice.
   if (hierarchical) {

@@ -224,44 +224,50 @@ SparseModel OneCameraAt(double x, double y) {
   return model;
 }
 
+// The parts' estimates of the principal point: (x ± dx, y) alternately.
+std::vector<SparseModel> PartsAt(double x, double dx, double y) {
+  return {OneCameraAt(x - dx, y), OneCameraAt(x + dx, y), OneCameraAt(x - dx, y), OneCameraAt(x + dx, y)};
+}
+
 TEST(CheckRefinedPrincipalPoint, APointMeasurablyOffCentreIsKept) {
   const ReconstructOptions options;
-  // 40 px off; the halves 4 px apart: 2 px standard deviation, 20 of them.
-  const PrincipalPointCheck kept =
-      CheckRefinedPrincipalPoint(OneCameraAt(540, 250), {OneCameraAt(538, 250), OneCameraAt(542, 250)}, options);
+  // 40 px off; four parts 4 px either side: each varies 3.3 px, the whole 1.6 px.
+  const PrincipalPointCheck kept = CheckRefinedPrincipalPoint(OneCameraAt(540, 250), PartsAt(540, 4, 250), options);
   EXPECT_TRUE(kept.keep);
   EXPECT_EQ(kept.note,
-            "principal point refined in a final bundle adjustment: 4.0% off-centre, 20.0 standard deviations "
-            "of its estimate (2.0 px, from two halves of the points)");
+            "principal point refined in a final bundle adjustment: 4.0% off-centre, 24.5 standard deviations "
+            "of its estimate (1.6 px, from 4 parts of the points)");
 }
 
 // As on 10 photos of a consumer camera undistorted to a centred pinhole: 2.9% off, but the
-// halves of the points disagree by more than that.
-TEST(CheckRefinedPrincipalPoint, APointTheHalvesDisagreeOnStaysAtTheCentre) {
+// parts of the points disagree by more than that.
+TEST(CheckRefinedPrincipalPoint, APointThePartsDisagreeOnStaysAtTheCentre) {
   const ReconstructOptions options;
   const PrincipalPointCheck rejected =
-      CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(490, 250), OneCameraAt(570, 250)}, options);
+      CheckRefinedPrincipalPoint(OneCameraAt(529, 250), PartsAt(530, 40, 250), options);
   EXPECT_FALSE(rejected.keep);
   EXPECT_EQ(rejected.note,
             "principal point kept at the image centre: the refined one, 29.0 px off it, is within three standard "
-            "deviations of its estimate (40.0 px, from two halves of the points)");
-  // Just past three standard deviations (9.5 px each): kept.
-  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(519.5, 250), OneCameraAt(538.5, 250)},
-                                         options).keep);
+            "deviations of its estimate (16.3 px, from 4 parts of the points)");
+  // Either side of three standard deviations (9.4 and 9.8 px): kept, then not.
+  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), PartsAt(529, 23, 250), options).keep);
+  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), PartsAt(529, 24, 250), options).keep);
+  EXPECT_THROW(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(529, 250)}, options),
+               std::invalid_argument);
 }
 
 TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitStaysAtTheCentre) {
   ReconstructOptions options;
   options.max_refined_principal_point_offset = 0.05;
   const SparseModel drifted = OneCameraAt(500, 290);  // 8% of the height off-centre.
-  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(drifted, {drifted, drifted}, options);
+  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(drifted, PartsAt(500, 0, 290), options);
   EXPECT_FALSE(rejected.keep);
   EXPECT_EQ(rejected.note,
             "principal point kept at the image centre: the refined one drifted 8.0% of the image size off-centre "
             "(not observable in these photos)");
 }
 
-TEST(HalfOfThePoints, EveryOtherPointAndOnlyItsObservations) {
+TEST(PartOfThePoints, EveryKthPointAndOnlyItsObservations) {
   SparseModel model = OneCameraAt(500, 250);
   SparseImage image;
   image.id = 7;
@@ -276,14 +282,14 @@ TEST(HalfOfThePoints, EveryOtherPointAndOnlyItsObservations) {
   }
   image.points2d.push_back({Eigen::Vector2d(1, 1), kInvalidPoint3DId});
   model.AddImage(image);
-  for (int parity : {0, 1}) {
-    const SparseModel half = HalfOfThePoints(model, parity);
+  for (int part : {0, 1}) {
+    const SparseModel half = PartOfThePoints(model, part, 2);
     std::vector<uint64_t> ids, observed;
     for (const Point3D& point : half.Points3D()) ids.push_back(point.id);
     for (const Point2D& point : half.ImageById(7).points2d) {
       if (point.point3d_id != kInvalidPoint3DId) observed.push_back(point.point3d_id);
     }
-    EXPECT_EQ(ids, parity == 0 ? std::vector<uint64_t>({10, 12, 14}) : std::vector<uint64_t>({11, 13}));
+    EXPECT_EQ(ids, part == 0 ? std::vector<uint64_t>({10, 12, 14}) : std::vector<uint64_t>({11, 13}));
     EXPECT_EQ(observed, ids);
     EXPECT_EQ(half.ImageById(7).points2d.size(), 6u);  // Keypoints stay, for colmap's ids.
     EXPECT_EQ(half.Cameras().size(), 1u);
