@@ -335,8 +335,9 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
   hasher.Add(matches_key)
       .Add(sfm.camera.fixed_intrinsics)
       .Add(refine_principal_point)
-      .Add(refine_principal_point ? "checked on parts of the points" : "")
       .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
+  // Only a refining mapper's key changed with the principal point's check.
+  if (refine_principal_point) hasher.Add("checked on parts of the points");
   // The incremental mapper keeps the keys it had before there was a choice.
   if (hierarchical) {
     hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images)).Add("adjusted-2");
