@@ -84,16 +84,14 @@ PixelShareLoss ShareLoss(const Image& render, const Image& truth, const std::vec
   return loss;
 }
 
-LossBudget BudgetOf(const Image& render, const Image& truth, const ClassMap& classes, double psnr,
-                    double psnr_exposure_matched) {
+LossBudget BudgetOf(const Image& render, const Image& truth, const ClassMap& classes, const HoleMetrics& metrics,
+                    double psnr, double psnr_exposure_matched) {
   LossBudget budget;
   budget.covered = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kCovered}), psnr);
   budget.background = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kBackground}), psnr);
   budget.filled = ShareLoss(
       render, truth, MaskOf(classes, {PixelClass::kOutOfView, PixelClass::kCrack, PixelClass::kDisocclusion}), psnr);
-  const std::vector<uint8_t> out_of_view = MaskOf(classes, {PixelClass::kOutOfView});
-  budget.out_of_view_share = static_cast<double>(std::count(out_of_view.begin(), out_of_view.end(), uint8_t{1})) /
-                             static_cast<double>(out_of_view.size());
+  budget.out_of_view_share = metrics.out_of_view_ratio;
   budget.exposure_db = psnr_exposure_matched - psnr;
   return budget;
 }
@@ -156,7 +154,8 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
                                Psnr(render, truth_image, sampled),
                                Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
                                metrics.hole_ratio, view.sources};
-    score.budget = BudgetOf(render, truth_image, view.result.classes, score.psnr, score.psnr_exposure_matched);
+    score.budget =
+        BudgetOf(render, truth_image, view.result.classes, metrics, score.psnr, score.psnr_exposure_matched);
     evaluation.per_view.push_back(score);
     evaluation.psnr_mean += score.psnr;
     evaluation.ssim_mean += score.ssim;
