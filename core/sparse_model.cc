@@ -244,6 +244,18 @@ SparseModel ReadSparseModelWithoutKeypoints(const fs::path& dir) {
   return model;
 }
 
+namespace {
+
+// `image` with its observations of points other than `points` cleared (its keypoints stay).
+SparseImage ObservingOnly(SparseImage image, const std::unordered_set<uint64_t>& points) {
+  for (Point2D& point : image.points2d) {
+    if (!points.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
+  }
+  return image;
+}
+
+}  // namespace
+
 SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& names, bool keep) {
   std::unordered_set<uint32_t> images, cameras;
   for (const SparseImage& image : model.Images()) {
@@ -265,13 +277,20 @@ SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& 
     selected.AddPoint3D(std::move(kept));
   }
   for (const SparseImage& image : model.Images()) {
-    if (!images.count(image.id)) continue;
-    SparseImage kept = image;
-    for (Point2D& point : kept.points2d) {
-      if (!points.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
-    }
-    selected.AddImage(std::move(kept));
+    if (images.count(image.id)) selected.AddImage(ObservingOnly(image, points));
   }
+  return selected;
+}
+
+SparseModel SelectPoints(const SparseModel& model, size_t first, size_t step) {
+  SparseModel selected;
+  for (const Camera& camera : model.Cameras()) selected.AddCamera(camera);
+  std::unordered_set<uint64_t> points;
+  for (size_t i = first; i < model.Points3D().size(); i += step) {
+    selected.AddPoint3D(model.Points3D()[i]);
+    points.insert(model.Points3D()[i].id);
+  }
+  for (const SparseImage& image : model.Images()) selected.AddImage(ObservingOnly(image, points));
   return selected;
 }
 

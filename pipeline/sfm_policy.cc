@@ -282,23 +282,6 @@ bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& 
          num_images >= options.refine_principal_point_min_images;
 }
 
-SparseModel PartOfThePoints(const SparseModel& model, int part, int parts) {
-  SparseModel selected;
-  for (const Camera& camera : model.Cameras()) selected.AddCamera(camera);
-  std::set<uint64_t> kept;
-  for (size_t i = static_cast<size_t>(part); i < model.Points3D().size(); i += static_cast<size_t>(parts)) {
-    selected.AddPoint3D(model.Points3D()[i]);
-    kept.insert(model.Points3D()[i].id);
-  }
-  for (SparseImage image : model.Images()) {
-    for (Point2D& point : image.points2d) {
-      if (!kept.count(point.point3d_id)) point.point3d_id = kInvalidPoint3DId;
-    }
-    selected.AddImage(std::move(image));
-  }
-  return selected;
-}
-
 namespace {
 
 Eigen::Vector2d PrincipalPoint(const Camera& camera) { return {camera.PrincipalX(), camera.PrincipalY()}; }

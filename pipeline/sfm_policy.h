@@ -131,19 +131,15 @@ std::set<std::string> HeldOutPhotos(const std::vector<std::string>& names, int e
 // camera whose intrinsics are estimated, from `options.refine_principal_point_min_images`.
 bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& options, int num_images);
 
-// How many parts of the points the principal point is refined on apart, to measure how well the
-// photos determine it.
-inline constexpr int kPrincipalPointParts = 4;
-
-// `model` with every `parts`-th point from the `part`-th: the others and their observations
-// removed.
-SparseModel PartOfThePoints(const SparseModel& model, int part, int parts);
+// How many parts of the points the principal point is refined on apart (every K-th point,
+// SelectPoints), to measure how well the photos determine it.
+inline constexpr size_t kPrincipalPointParts = 4;
 
 // Whether a model whose principal points were refined is kept, and report.json's note saying
 // which and why. Kept where every camera's refined principal point is within
 // `options.max_refined_principal_point_offset` of the image centre and measurably off it:
 // farther from the centre than three standard deviations of its estimate. The refinements on
-// disjoint parts of the points (`parts`, PartOfThePoints) give the deviation: with 1/K of the
+// disjoint parts of the points (`parts`) give the deviation: with 1/K of the
 // points each, they scatter sqrt(K) times as widely. Otherwise the centre stays, as COLMAP keeps
 // it by default: a few photos of a facade cannot tell a shifted principal point from a turned
 // camera.

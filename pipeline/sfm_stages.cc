@@ -111,8 +111,8 @@ PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   const SparseModel model = AdjustRawModel(sfm.colmap, sfm.workspace, refine, "refine", sfm.progress);
   const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
   std::vector<SparseModel> parts;
-  for (int part = 0; part < kPrincipalPointParts; ++part) {
-    parts.push_back(AdjustModel(sfm.colmap, sfm.workspace, PartOfThePoints(raw, part, kPrincipalPointParts), refine,
+  for (size_t part = 0; part < kPrincipalPointParts; ++part) {
+    parts.push_back(AdjustModel(sfm.colmap, sfm.workspace, SelectPoints(raw, part, kPrincipalPointParts), refine,
                                 "refine_part", sfm.progress));
   }
   const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, parts, sfm.options);

@@ -267,34 +267,5 @@ TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitStaysAtTheCentre) {
             "(not observable in these photos)");
 }
 
-TEST(PartOfThePoints, EveryKthPointAndOnlyItsObservations) {
-  SparseModel model = OneCameraAt(500, 250);
-  SparseImage image;
-  image.id = 7;
-  image.camera_id = 1;
-  image.name = "a.png";
-  for (uint64_t id = 10; id < 15; ++id) {
-    Point3D point;
-    point.id = id;
-    point.track = {{7, static_cast<uint32_t>(image.points2d.size())}};
-    image.points2d.push_back({Eigen::Vector2d(static_cast<double>(id), 0), id});
-    model.AddPoint3D(point);
-  }
-  image.points2d.push_back({Eigen::Vector2d(1, 1), kInvalidPoint3DId});
-  model.AddImage(image);
-  for (int part : {0, 1}) {
-    const SparseModel half = PartOfThePoints(model, part, 2);
-    std::vector<uint64_t> ids, observed;
-    for (const Point3D& point : half.Points3D()) ids.push_back(point.id);
-    for (const Point2D& point : half.ImageById(7).points2d) {
-      if (point.point3d_id != kInvalidPoint3DId) observed.push_back(point.point3d_id);
-    }
-    EXPECT_EQ(ids, part == 0 ? std::vector<uint64_t>({10, 12, 14}) : std::vector<uint64_t>({11, 13}));
-    EXPECT_EQ(observed, ids);
-    EXPECT_EQ(half.ImageById(7).points2d.size(), 6u);  // Keypoints stay, for colmap's ids.
-    EXPECT_EQ(half.Cameras().size(), 1u);
-  }
-}
-
 }  // namespace
 }  // namespace parallax
