@@ -48,6 +48,9 @@ void AddNovelViewOptions(CLI::App& command, NovelViewSettings& settings) {
                      "hole filling: none, inpaint (OpenCV Telea, the baseline) or depth-aware "
                      "(default: from the background side)")
       ->transform(CLI::CheckedTransformer(fills, CLI::ignore_case));
+  command.add_flag("--no-fill-from-sources{false}", settings.render.fill.from_sources,
+                   "depth-aware fill: keep the fill's color in holes whose continued surface a "
+                   "source saw without depth, instead of that source's color");
 }
 
 }  // namespace parallax

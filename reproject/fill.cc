@@ -60,6 +60,11 @@ class SkyModel {
     Moments sum;
     for (const Moments& row : rows) sum.Add(row);
     if (sum.count < kMinSamples) return;
+    int below = 0;
+    for (size_t row = 0; row < rows.size() && 2 * below < sum.count; ++row) {
+      below += rows[row].count;
+      median_row_ = 2 * static_cast<int>(row);
+    }
     // The least-squares fit of rgb = c0 + C (ray - mean ray), from the sums: centred on the
     // mean ray, the constant and the gradient decouple. Rays are unit vectors, so the
     // centred second moments lose ~4 of double's 16 digits even over a patch of sky 0.01 rad
@@ -82,6 +87,9 @@ class SkyModel {
 
   // False when too little background landed to fit (then FillPixel averages neighbours).
   bool Valid() const { return valid_; }
+
+  // The row with half the landed background above it: where the sky is, seen from this view.
+  int MedianRow() const { return median_row_; }
 
   // Color at pixel (x, y), clamped to [0, max(1, brightest fitted value)] per channel (far
   // outside the fitted rays a linear model can run away; photos are at most 1).
@@ -122,6 +130,7 @@ class SkyModel {
   Eigen::Vector3d mean_ray_ = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 4, 3> coefficients_ = Eigen::Matrix<double, 4, 3>::Zero();
   float max_[3] = {1, 1, 1};
+  int median_row_ = 0;
   bool valid_ = false;
 };
 
@@ -142,13 +151,14 @@ class DepthAwareFiller {
   }
 
   // How many directions must find background at infinity for it to be the background side of
-  // a pixel of class c: one out of view (background is the farthest of all); for a hole,
-  // where the ray reaches something the sources see behind what is in front of it,
-  // hole_sky_share of them where it is open to the sky, else more than there are (background
-  // only where no surface is found: sky next to a disoccluded wall top would win as
-  // "farthest").
-  int SkyDirections(PixelClass c, bool open_to_sky) const {
-    if (!IsHole(c)) return 1;
+  // pixel (x, y) of class c. Out of view: one (background is the farthest of all) at or above
+  // the sky's median row, else more than there are: beside the sources' frames a wall or the
+  // ground goes on, and one far patch of sky must not paint them (below the sky, background
+  // only where no surface is found). For a hole, where the ray reaches something the sources
+  // see behind what is in front of it, hole_sky_share of them where it is open to the sky,
+  // else more than there are (sky next to a disoccluded wall top would win as "farthest").
+  int SkyDirections(PixelClass c, bool open_to_sky, int y) const {
+    if (!IsHole(c)) return y <= sky_.MedianRow() ? 1 : count_ + 1;
     return open_to_sky ? hole_sky_directions_ : count_ + 1;
   }
 
@@ -178,7 +188,7 @@ class DepthAwareFiller {
         row.right = x + 1;
         while (row.right < width_ && kind[row.right] == SampleKind::kNone) ++row.right;
       }
-      const int sky_directions = SkyDirections(pixel_class, classes.OpenToSky(x, y));
+      const int sky_directions = SkyDirections(pixel_class, classes.OpenToSky(x, y), y);
       if (FillPixel(x, y, sky_directions, row)) ++filled;
     }
     return filled;

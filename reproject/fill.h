@@ -30,6 +30,9 @@ struct FillOptions {
   // surface. Below 1 a gap between two walls, hidden behind the nearer one, gets the sky; too
   // low a share lets holes in far ground, open to the sky above, take it too.
   double hole_sky_share = 0.5;
+  // kDepthAware: holes whose filled surface some source saw without depth take that source's
+  // color (FillFromSources, fill_from_sources.h).
+  bool from_sources = true;
   // kInpaint: Telea neighbourhood radius in pixels, > 0.
   double inpaint_radius_px = 3;
 
@@ -38,6 +41,7 @@ struct FillOptions {
 
 struct FillSummary {
   int filled_px = 0;  // Pixels that received a color.
+  int from_sources_px = 0;  // Of those, hole pixels colored from the sources (from_sources).
   // Share of all pixels still without color after filling (holes nothing reached, and
   // out-of-view pixels when they are not filled). 0 when everything got a color.
   double hole_ratio_filled = 0;
@@ -48,7 +52,9 @@ struct FillSummary {
 // Fills the pixels of `blend` where nothing landed (holes; out-of-view ones too with
 // fill_out_of_view). kDepthAware scans `directions` rays from the pixel to the nearest pixel
 // with a sample, keeps the candidates whose depth is the farthest (background at infinity
-// counts as farthest, except for holes: see hole_sky_share) within background_tolerance, and
+// counts as farthest, except for holes, see hole_sky_share, and for out-of-view pixels below
+// the row with half the landed background above it: photos are upright, and beside the
+// sources' frames the wall or ground they saw goes on) within background_tolerance, and
 // averages their colors weighted by inverse distance; surface fills also get that averaged
 // depth. A disocclusion is hidden background, so its color comes from the background side,
 // not from the occluder. Where the background side is background at infinity, the color

@@ -6,11 +6,14 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
+
+#include "reproject/fill_from_sources.h"
 
 namespace parallax {
 namespace {
@@ -111,7 +114,15 @@ void Renderer::Finish(Clock::time_point start, double warp_ms, RenderResult* res
   timings.classify_ms = MsSince(step);
 
   step = Clock::now();
-  const FillSummary fill = FillHoles(classes, target_.camera, options_.fill, &blend_);
+  FillSummary fill = FillHoles(classes, target_.camera, options_.fill, &blend_);
+  if (options_.fill.from_sources && options_.fill.method == FillMethod::kDepthAware) {
+    std::vector<FillSource> fill_sources;
+    for (size_t i = 0; i < sources_.size(); ++i) {
+      fill_sources.push_back({sources_[i]->Posed(), &sources_[i]->color, &sources_[i]->depth,
+                              &scratch_[i].Background()});
+    }
+    fill.from_sources_px = FillFromSources(classes, target_, fill_sources, &blend_).colored_px;
+  }
   timings.fill_ms = MsSince(step);
 
   // Nothing above touched *result: a throw leaves it as it was.

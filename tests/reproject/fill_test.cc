@@ -183,6 +183,41 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
   EXPECT_THROW(options.Check(), std::invalid_argument);
 }
 
+// Sky in the top rows of the right half, a grey wall (depth 5) below it, and the left half out
+// of view. From the left half, some steep marches up and to the right find the sky, the others
+// the wall: below the sky's median row the wall goes on (beside the sources' frames a surface
+// continues; one patch of sky painted streaks across it), at its rows the sky does.
+TEST(FillHoles, OutOfViewBelowTheSkyContinuesTheSurface) {
+  constexpr int kSize = 64, kSkyRows = 16;
+  const Eigen::Vector3f sky(0.5f, 0.6f, 0.9f), wall(0.4f, 0.4f, 0.4f);
+  BlendResult blend;
+  blend.color.Reset(kSize, kSize, 3);
+  blend.depth.Reset(kSize, kSize);
+  blend.kind.assign(kSize * kSize, SampleKind::kNone);
+  ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kOutOfView), {}};
+  for (int y = 0; y < kSize; ++y) {
+    for (int x = kSize / 2; x < kSize; ++x) {
+      const size_t i = static_cast<size_t>(y * kSize + x);
+      const bool is_sky = y < kSkyRows;
+      const Eigen::Vector3f& color = is_sky ? sky : wall;
+      for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
+      blend.depth.Values()[i] = is_sky ? 0.0f : 5.0f;
+      blend.kind[i] = is_sky ? SampleKind::kBackground : SampleKind::kSurface;
+      classes.classes[i] = is_sky ? PixelClass::kBackground : PixelClass::kCovered;
+    }
+  }
+  FillHoles(classes, MakePinholeCamera(1, kSize, kSize, 64, 64, 32, 32), {}, &blend);
+  for (int y = kSkyRows; y < kSize; ++y) {
+    for (int x = 0; x < kSize / 2; ++x) {
+      for (int ch = 0; ch < 3; ++ch) ASSERT_NEAR(blend.color.At(x, y, ch), wall(ch), 1e-5) << x << "," << y;
+      ASSERT_NEAR(blend.depth.At(x, y), 5, 1e-5);
+    }
+  }
+  for (int y = 0; y < kSkyRows / 2 - 1; ++y) {  // The sky half has every other row sampled.
+    for (int x = 0; x < kSize / 2; ++x) ASSERT_EQ(blend.depth.At(x, y), 0) << x << "," << y;
+  }
+}
+
 // A sky whose color is affine in the direction (y is down: bluer upwards), seen by a source
 // looking level and rendered by a target pitched 12 degrees up: the target's top rows are
 // sky no source saw.
