@@ -36,7 +36,8 @@ void RegisterRenderCommand(CLI::App& app) {
       "COLMAP model (text or binary) of the cameras to render, in the input's frame");
   auto* path = command->add_option(
       "--path", arguments->path,
-      "camera path: orbit:N (N views around the scene) or between:IMAGE_A,IMAGE_B,N");
+      "camera path: orbit:N (N views around the scene, or along the arc the photos were taken from "
+      "when they leave a quarter of the circle out) or between:IMAGE_A,IMAGE_B,N");
   cameras->excludes(path);
   path->excludes(cameras);
   command->add_option("--out", arguments->out, "output folder (created if missing)")->required();

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <tuple>
 
 #include <Eigen/Dense>
 
@@ -135,11 +136,13 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
   const Eigen::Vector3f grow = Eigen::Vector3f::Constant(0.5f * extent.diagonal().norm());
   const Eigen::AlignedBox3f near_extent(extent.min() - grow, extent.max() + grow);
   if (!near_extent.contains(rig.target.cast<float>())) return std::nullopt;
-  std::vector<double> distances, elevations, half_width_tans;
+  std::vector<double> distances, elevations, half_width_tans, azimuths;
   size_t in_front = 0;
+  const auto [u, v] = GroundAxes(up);
   for (const FrameCamera& camera : cameras) {
     in_front += (camera.cam_from_world * rig.target).z() > 0;
     const Eigen::Vector3d offset = CameraCenter(camera.cam_from_world) - rig.target;
+    azimuths.push_back(std::atan2(offset.dot(v), offset.dot(u)) * 180 / std::numbers::pi);
     distances.push_back(offset.norm());
     half_width_tans.push_back(0.5 * static_cast<double>(camera.camera.width) / camera.camera.FocalX());
     elevations.push_back(std::asin(std::clamp(up.dot(offset) / std::max(offset.norm(), 1e-12), -1.0, 1.0)) * 180 /
@@ -153,8 +156,26 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
   rig.distance = median(distances);
   rig.elevation_deg = median(elevations);
   rig.half_width_tan = median(half_width_tans);
+  std::tie(rig.arc_start_deg, rig.arc_span_deg) = AzimuthArc(azimuths);
   if (!(rig.distance > 0)) return std::nullopt;
   return rig;
+}
+
+std::pair<double, double> AzimuthArc(std::vector<double> azimuths_deg) {
+  if (azimuths_deg.size() < 2) return {0, 360};
+  for (double& azimuth : azimuths_deg) azimuth -= 360 * std::floor(azimuth / 360);
+  std::sort(azimuths_deg.begin(), azimuths_deg.end());
+  // The gap from the last azimuth round to the first, then between neighbours.
+  double widest = azimuths_deg.front() + 360 - azimuths_deg.back();
+  double start = azimuths_deg.front();
+  for (size_t i = 1; i < azimuths_deg.size(); ++i) {
+    const double gap = azimuths_deg[i] - azimuths_deg[i - 1];
+    if (gap > widest) {
+      widest = gap;
+      start = azimuths_deg[i];
+    }
+  }
+  return {start, 360 - widest};
 }
 
 SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& cloud,

@@ -34,6 +34,10 @@ struct CameraRig {
   double distance = 0;        // Median distance of the cameras to the target.
   double elevation_deg = 0;   // Median elevation of the cameras seen from the target.
   double half_width_tan = 0;  // Median tan of the photos' horizontal half field of view.
+  // The arc of azimuths (OrbitPose's, about up) the cameras stand on: from arc_start_deg over
+  // arc_span_deg, the circle less its widest gap between two cameras; 360 with one camera.
+  double arc_start_deg = 0;
+  double arc_span_deg = 360;
 };
 
 struct SceneFrame {
@@ -65,6 +69,10 @@ std::optional<Eigen::Vector3d> LookedAtPoint(const std::vector<FrameCamera>& cam
 // The cameras' mean "up" (-y) in world coordinates; nullopt without cameras or when they
 // disagree so much that the mean is meaningless (its length under 0.3 per camera).
 std::optional<Eigen::Vector3d> CamerasUp(const std::vector<FrameCamera>& cameras);
+
+// The arc of the circle the azimuths (degrees, any range) cover: the circle less its widest
+// gap between neighbouring azimuths, as {start in [0, 360), span}; {0, 360} for fewer than two.
+std::pair<double, double> AzimuthArc(std::vector<double> azimuths_deg);
 
 // The rig of cameras looking in at their LookedAtPoint: nullopt when there is no such point,
 // or when it is behind more than a quarter of the cameras or farther than half `extent`'s

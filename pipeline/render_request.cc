@@ -99,7 +99,32 @@ RequestStage DepthHolesStage(bool scene_folder, const SourceLibrary& library,
                                 depth_holes.note);
 }
 
-RequestStage FillStage(const std::map<std::string, size_t>& fill_skipped, size_t views) {
+// The share of a frame no surface reached (holes and out of view), which the fill made.
+double FilledShare(const RenderResult& result) {
+  return result.metrics.hole_ratio + result.metrics.out_of_view_ratio;
+}
+
+// How much of the frames the fill made: the mean share and the frame with the most.
+struct FilledFrames {
+  double sum = 0;
+  double most = -1;
+  std::string most_name;
+
+  void Add(const std::string& name, double share) {
+    sum += share;
+    if (share > most) most = share, most_name = name;
+  }
+  std::string Say(size_t views) const {
+    if (views == 0) return "";
+    char text[160];
+    std::snprintf(text, sizeof text, "; %.1f%% of each frame filled on average, most in %s (%.1f%%)",
+                  100 * sum / static_cast<double>(views), most_name.c_str(), 100 * most);
+    return text;
+  }
+};
+
+RequestStage FillStage(const std::map<std::string, size_t>& fill_skipped, const FilledFrames& filled,
+                       size_t views) {
   std::string fill_skips;
   size_t skipped_views = 0;
   for (const auto& [reason, count] : fill_skipped) {
@@ -108,7 +133,7 @@ RequestStage FillStage(const std::map<std::string, size_t>& fill_skipped, size_t
   }
   const bool none_filled = !fill_skipped.empty() && skipped_views == views;
   const std::string ran = "ran for " + std::to_string(views - skipped_views) + " of " +
-                          std::to_string(views) + " views" + fill_skips;
+                          std::to_string(views) + " views" + filled.Say(views) + fill_skips;
   return none_filled ? Skipped("fill", fill_skips.substr(2)) : Ran("fill", ran);
 }
 
@@ -227,6 +252,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   std::string csv;
   double hole_sum = 0, filled_sum = 0, ms_sum = 0;
   std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.
+  FilledFrames filled_frames;
   Renderer renderer(settings.render);
   NovelView view;
   for (size_t i = 0; i < targets.size(); ++i) {
@@ -237,6 +263,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
     filled_sum += view.result.fill.hole_ratio_filled;
     ms_sum += view.ms;
     if (!view.result.fill.skipped.empty()) ++fill_skipped[view.result.fill.skipped];
+    filled_frames.Add(targets[i].name, FilledShare(view.result));
     if (on_view) on_view(i, targets.size(), targets[i], view);
   }
   summary.sources_loaded = library.LoadedCount();
@@ -244,7 +271,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
                                               std::to_string(summary.source_views) +
                                               " source views: the others can not contribute to these cameras"));
   summary.stages.push_back(DepthHolesStage(scene_folder, library, depth_holes));
-  summary.stages.push_back(FillStage(fill_skipped, targets.size()));
+  summary.stages.push_back(FillStage(fill_skipped, filled_frames, targets.size()));
   if (part.step == RenderStep::kFrames) {
     // The report first: a block counts as done once its rows are there.
     WriteStages(BlockReport(out, std::to_string(part.block)), summary.stages);

@@ -54,14 +54,26 @@ SceneFrame ReadSceneFrame(const fs::path& root, const std::vector<PosedCamera>& 
   return FitSceneFrame(mesh, cloud, cameras);
 }
 
-// Frame i at azimuth 360 i / N on the DefaultOrbit for the first source's intrinsics: where
-// `parallax view --orbit` stands with that camera's size and field of view.
+// A rig whose cameras leave a gap wider than this (degrees of azimuth) does not surround the
+// scene: an orbit beyond its arc would look where no photo did.
+constexpr double kMaxGapAroundDeg = 90;
+
+// The azimuth of frame i of n: 360 i / n around the scene, or, when the photos were taken
+// from an arc of it only, evenly from one end of that arc to the other.
+double OrbitAzimuth(const SceneFrame& frame, int i, int n) {
+  if (!frame.rig || frame.rig->arc_span_deg >= 360 - kMaxGapAroundDeg) return 360.0 * i / n;
+  const double share = n > 1 ? static_cast<double>(i) / (n - 1) : 0.5;
+  return frame.rig->arc_start_deg + share * frame.rig->arc_span_deg;
+}
+
+// Frame i on the DefaultOrbit for the first source's intrinsics, at OrbitAzimuth: where
+// `parallax view --orbit` stands at that azimuth with that camera's size and field of view.
 std::vector<NamedCamera> OrbitCameras(int frames, const fs::path& root, const std::vector<PosedCamera>& sources) {
   const SceneFrame frame = ReadSceneFrame(root, sources);
   const Camera& camera = sources.front().camera;
   std::vector<NamedCamera> cameras;
   for (int i = 0; i < frames; ++i) {
-    const double azimuth_deg = 360.0 * i / frames;
+    const double azimuth_deg = OrbitAzimuth(frame, i, frames);
     cameras.push_back({FrameName("orbit", i), {camera, DefaultOrbitPose(frame, azimuth_deg, std::nullopt, camera)}});
   }
   return cameras;

@@ -113,6 +113,10 @@ TEST(RenderCli, WorkspaceWithoutDepthEstimatesOnlyTheSourcesItUses) {
   EXPECT_FALSE(fs::exists(Workspace(workspace).MeshDir())) << "the atlas is never made for novel views";
   EXPECT_TRUE(stages.at("depth_holes").at("skipped").get<bool>());
   EXPECT_NE(stages.at("depth_holes").at("reason").get<std::string>().find("mesh.obj"), std::string::npos);
+  // How much of the frames the fill made, and where most.
+  EXPECT_NE(stages.at("fill").at("reason").get<std::string>().find("% of each frame filled on average, most in between_000"),
+            std::string::npos)
+      << stages.at("fill").dump();
 
   // With a mesh in the workspace (here the ground plane, z = 0 in the known cameras' frame),
   // the pixels the depth maps have no depth for take the mesh's: fewer holes.

@@ -6,6 +6,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "geometry/obj.h"
+#include "geometry/scene_frame.h"
 #include "reproject/novel_views.h"
 #include "tests/temp_dir.h"
 #include "viewer/view_cameras.h"
@@ -48,6 +50,13 @@ void WriteCameras(const fs::path& ws, int count, const Placement& placement) {
 // Cameras on a circle of radius 6, 2.5 above the ground, looking at the box's centre.
 Rigid3d RingCamera(int index) {
   const double angle = 2 * std::numbers::pi * index / 8 + 0.3;
+  const Eigen::Vector3d eye(6 * std::cos(angle), 6 * std::sin(angle), 2.5);
+  return LookAt(eye, Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d::UnitZ());
+}
+
+// Cameras on a 100-degree arc of the ring, as in front of a facade.
+Rigid3d ArcCamera(int index) {
+  const double angle = 0.3 + (100 * std::numbers::pi / 180) * index / 5;
   const Eigen::Vector3d eye(6 * std::cos(angle), 6 * std::sin(angle), 2.5);
   return LookAt(eye, Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d::UnitZ());
 }
@@ -130,6 +139,41 @@ TEST(Orbit, RenderOrbitIsTheViewOrbitAroundTheFocusWithoutARig) {
   WriteGeometry(ws);
   ASSERT_FALSE(LoadViewerScene(ws).rig.has_value()) << "cameras looking ahead make no rig";
   ExpectRenderOrbitIsViewOrbit(ws);
+}
+
+// Photos from an arc of the circle only: the orbit runs from one end of the arc to the other
+// (beyond it, it would look where no photo did), still the view orbit at those azimuths.
+TEST(Orbit, RenderOrbitKeepsToTheArcThePhotosWereTakenFrom) {
+  const TempDir dir;
+  const fs::path ws = dir.Path() / "ws";
+  WriteCameras(ws, 6, ArcCamera);
+  WriteGeometry(ws);
+  const ViewerScene scene = LoadViewerScene(ws);
+  ASSERT_TRUE(scene.rig.has_value());
+  EXPECT_NEAR(scene.rig->arc_span_deg, 100, 0.01);  // The rig's target is a least-squares fit.
+  const std::vector<NamedCamera> render = RenderOrbit(ws);
+  const double fov_deg = 2 * std::atan(0.5 * kWidth / kFocal) * 180 / std::numbers::pi;
+  for (int k = 0; k < 12; ++k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const double azimuth = scene.rig->arc_start_deg + scene.rig->arc_span_deg * k / 11;
+    const ViewCamera view = OrbitViewCamera(scene, azimuth, std::nullopt, kWidth, kHeight, fov_deg);
+    const Rigid3d& orbit = render[static_cast<size_t>(k)].camera.cam_from_world;
+    EXPECT_LT((orbit.translation - view.cam_from_world.translation).norm(), 1e-9);
+    // Its centre stands within the photos' azimuths about the rig's target.
+    const Eigen::Vector3d offset = CameraCenter(orbit) - scene.rig->target;
+    const double degrees = std::atan2(offset.y(), offset.x()) * 180 / std::numbers::pi;
+    EXPECT_GE(degrees, 0.3 * 180 / std::numbers::pi - 0.01);
+    EXPECT_LE(degrees, 0.3 * 180 / std::numbers::pi + 100 + 0.01);
+  }
+}
+
+TEST(Orbit, AzimuthArcIsTheCircleLessItsWidestGap) {
+  EXPECT_EQ(AzimuthArc({}), std::make_pair(0.0, 360.0));
+  EXPECT_EQ(AzimuthArc({42}), std::make_pair(0.0, 360.0));
+  const auto [start, span] = AzimuthArc({20, -10, 10, 370});
+  EXPECT_NEAR(start, 350, 1e-9);
+  EXPECT_NEAR(span, 30, 1e-9);
+  EXPECT_NEAR(AzimuthArc({0, 90, 180, 270}).second, 270, 1e-9);
 }
 
 // A scene folder, or a workspace without mesh and cloud: the cameras alone make the frame, so
