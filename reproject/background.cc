@@ -78,11 +78,11 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
       stack.push_back(i);
     }
   };
-  for (int x = 0; x < width; ++x) {
-    push(x, 0);
-    push(x, height - 1);
-  }
-  for (int y = 0; y < height; ++y) {
+  // From the top row and the upper half of the sides: the sky is above the scene, and smooth
+  // ground without depth reaching the bottom or the lower sides (a lawn, a square) is not
+  // at infinity.
+  for (int x = 0; x < width; ++x) push(x, 0);
+  for (int y = 0; y < height / 2; ++y) {
     push(0, y);
     push(width - 1, y);
   }

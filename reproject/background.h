@@ -10,15 +10,16 @@
 
 namespace parallax {
 
-// Marks the depth-0 pixels that are 4-connected to the image border through depth-0 pixels
-// smooth in color: in our outdoor scenes that is the sky and the far background, which a
+// Marks the depth-0 pixels that are 4-connected to the image's top row or the upper half of
+// its sides through depth-0 pixels smooth in color: in our outdoor scenes that is the sky and
+// the far background (photos are upright), which a
 // renderer warps as directions (rotation only). A pixel is smooth when every channel of
 // `color` (linear RGB, the depth's size) is within max_step x the larger value (+ 0.002, for
 // dark noise) of each 4-neighbour's: a sky gradient is, the ground is not (pixels next to
 // one with depth pass: silhouettes mix colors). Depth-0 pixels
-// enclosed by valid depth, or on textured ground the depth estimate missed (which touches the
-// border below the scene), are unknown, not background: they stay holes rather than land at
-// infinity. max_step >= 1 turns the color test off. Returns one byte per pixel, row-major,
+// enclosed by valid depth, on textured ground the depth estimate missed, or on smooth ground
+// reaching the border only below the scene, are unknown, not background: they stay holes
+// rather than land at infinity. max_step >= 1 turns the color test off. Returns one byte per pixel, row-major,
 // 1 = background. Throws std::invalid_argument when the sizes differ.
 std::vector<uint8_t> MarkBackground(const DepthMap& depth, const Image& color, float max_step);
 // The same into *background, reusing its memory and that of *stack (scratch for the fill).

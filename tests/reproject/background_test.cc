@@ -27,25 +27,28 @@ TEST(MarkBackground, OnlyDepthZeroConnectedToTheBorderIsBackground) {
   EXPECT_EQ(background[2 * 8 + 2], 0);
 }
 
-// No depth along the bottom border: smooth sky-like color there is background, a texture
-// (ground the depth stage missed) is not, and the color test can be turned off.
-TEST(MarkBackground, TexturedPixelsWithoutDepthAreUnknown) {
+// No depth along the top border: smooth sky-like color there is background, a texture is
+// not, and the color test can be turned off. Below the scene (depth in rows 2-3), smooth
+// color without depth reaching only the bottom border is ground, not sky.
+TEST(MarkBackground, TexturedPixelsAndGroundWithoutDepthAreUnknown) {
   DepthMap depth(8, 6);
   Image color(8, 6, 3);
   for (int y = 0; y < 6; ++y) {
     for (int x = 0; x < 8; ++x) {
       const bool textured = x >= 4 && (x + y) % 2 == 0;
       for (int c = 0; c < 3; ++c) color.At(x, y, c) = textured ? 0.2f : 0.6f + 0.001f * static_cast<float>(x);
-      if (y < 3) depth.At(x, y) = 2;
+      if (y == 2 || y == 3) depth.At(x, y) = 2;
     }
   }
   const std::vector<uint8_t> background = MarkBackground(depth, color, 0.05f);
-  EXPECT_EQ(background[5 * 8 + 1], 1);  // Smooth gradient.
-  EXPECT_EQ(background[5 * 8 + 5], 0);  // Checkerboard.
-  EXPECT_EQ(background[4 * 8 + 6], 0);
-  EXPECT_EQ(background[1 * 8 + 1], 0);  // Has depth.
+  EXPECT_EQ(background[0 * 8 + 1], 1);  // Smooth gradient.
+  EXPECT_EQ(background[0 * 8 + 5], 0);  // Checkerboard.
+  EXPECT_EQ(background[0 * 8 + 6], 0);
+  EXPECT_EQ(background[2 * 8 + 1], 0);  // Has depth.
+  EXPECT_EQ(background[5 * 8 + 1], 0);  // Smooth, but below the scene.
   const std::vector<uint8_t> untested = MarkBackground(depth, color, 1.0f);
-  EXPECT_EQ(untested[5 * 8 + 5], 1);
+  EXPECT_EQ(untested[0 * 8 + 5], 1);
+  EXPECT_EQ(untested[5 * 8 + 1], 0);
   EXPECT_THROW(MarkBackground(depth, Image(7, 6, 3), 0.05f), std::invalid_argument);
 }
 
