@@ -37,7 +37,8 @@ void RegisterRenderCommand(CLI::App& app) {
   auto* path = command->add_option(
       "--path", arguments->path,
       "camera path: orbit:N (N views around the scene, or along the arc the photos were taken from "
-      "when they leave a quarter of the circle out) or between:IMAGE_A,IMAGE_B,N");
+      "when they leave a quarter of the circle out), photos:N (N views along a smooth curve through "
+      "every photo camera) or between:IMAGE_A,IMAGE_B,N");
   cameras->excludes(path);
   path->excludes(cameras);
   command->add_option("--out", arguments->out, "output folder (created if missing)")->required();

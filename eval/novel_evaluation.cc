@@ -153,7 +153,7 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
     NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
                                Psnr(render, truth_image, sampled),
                                Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
-                               metrics.hole_ratio, view.sources};
+                               metrics.hole_ratio, view.sources, {}};
     score.budget =
         BudgetOf(render, truth_image, view.result.classes, metrics, score.psnr, score.psnr_exposure_matched);
     evaluation.per_view.push_back(score);

@@ -1,15 +1,19 @@
 #include "reproject/novel_views.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <sstream>
 #include <utility>
+#include <vector>
 
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "reproject/distorted_target.h"
 #include "core/image.h"
+#include "core/pose.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "geometry/obj.h"
@@ -79,6 +83,73 @@ std::vector<NamedCamera> OrbitCameras(int frames, const fs::path& root, const st
   return cameras;
 }
 
+// The sources in the order a tour visits them: by azimuth along the rig's arc (from its
+// start) when the cameras look in at a point, else by name (the order they were taken in).
+std::vector<size_t> TourOrder(const SceneFrame& frame, const std::vector<PosedCamera>& sources,
+                              const std::vector<std::string>& names) {
+  std::vector<double> keys(sources.size());
+  for (size_t i = 0; i < sources.size(); ++i) {
+    if (!frame.rig) continue;
+    const auto [u, v] = GroundAxes(frame.up);
+    const Eigen::Vector3d offset = CameraCenter(sources[i].cam_from_world) - frame.rig->target;
+    const double azimuth = std::atan2(offset.dot(v), offset.dot(u)) * 180 / std::numbers::pi;
+    keys[i] = azimuth - frame.rig->arc_start_deg - 360 * std::floor((azimuth - frame.rig->arc_start_deg) / 360);
+  }
+  std::vector<size_t> order(sources.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return frame.rig ? keys[a] < keys[b] : names[a] < names[b];
+  });
+  return order;
+}
+
+// Frames evenly spaced along a Catmull-Rom curve through the sources' centres (in TourOrder),
+// each looking as the two sources around it do (rotations slerped), with the first source's
+// intrinsics. One source: that camera, `frames` times.
+std::vector<NamedCamera> PhotoTourCameras(int frames, const SceneFrame& frame,
+                                          const std::vector<PosedCamera>& sources,
+                                          const std::vector<std::string>& names) {
+  const std::vector<size_t> order = TourOrder(frame, sources, names);
+  std::vector<Eigen::Vector3d> keys;
+  for (size_t index : order) keys.push_back(CameraCenter(sources[index].cam_from_world));
+  const auto key = [&](ptrdiff_t i) {
+    return keys[static_cast<size_t>(std::clamp<ptrdiff_t>(i, 0, static_cast<ptrdiff_t>(keys.size()) - 1))];
+  };
+  // Uniform Catmull-Rom on segment i: through key(i) at t = 0 and key(i + 1) at t = 1, C1 there.
+  const auto curve = [&](size_t segment, double t) -> Eigen::Vector3d {
+    const auto i = static_cast<ptrdiff_t>(segment);
+    return 0.5 * (2 * key(i) + (key(i + 1) - key(i - 1)) * t +
+                  (2 * key(i - 1) - 5 * key(i) + 4 * key(i + 1) - key(i + 2)) * t * t +
+                  (-key(i - 1) + 3 * key(i) - 3 * key(i + 1) + key(i + 2)) * t * t * t);
+  };
+  // The curve's length at kSteps points per segment, so frames are spaced by length, not by t.
+  constexpr int kSteps = 64;
+  const size_t segments = std::max<size_t>(1, keys.size() - 1);
+  std::vector<double> length{0};
+  for (size_t i = 0; i < segments; ++i) {
+    for (int step = 1; step <= kSteps; ++step) {
+      length.push_back(length.back() + (curve(i, static_cast<double>(step) / kSteps) -
+                                        curve(i, static_cast<double>(step - 1) / kSteps)).norm());
+    }
+  }
+  std::vector<NamedCamera> cameras;
+  for (int f = 0; f < frames; ++f) {
+    const double wanted = frames == 1 ? 0.5 * length.back() : length.back() * f / (frames - 1);
+    const size_t upper = static_cast<size_t>(std::lower_bound(length.begin(), length.end(), wanted) - length.begin());
+    const size_t sample = std::clamp<size_t>(upper, 1, length.size() - 1) - 1;
+    const double span = length[sample + 1] - length[sample];
+    const double part = span > 0 ? std::clamp((wanted - length[sample]) / span, 0.0, 1.0) : 0.0;
+    const size_t segment = std::min(sample / kSteps, segments - 1);
+    const double t = std::min(1.0, (static_cast<double>(sample - segment * kSteps) + part) / kSteps);
+    const Eigen::Vector3d centre = curve(segment, t);
+    const Rigid3d& a = sources[order[segment]].cam_from_world;
+    const Rigid3d& b = sources[order[std::min(segment + 1, order.size() - 1)]].cam_from_world;
+    const Eigen::Quaterniond rotation = InterpolatePose(a, b, t).rotation;
+    cameras.push_back({FrameName("photos", f), {sources.front().camera, Rigid3d(rotation, -(rotation * centre))}});
+  }
+  return cameras;
+}
+
 }  // namespace
 
 ViewSetPaths SourcePathsFor(const fs::path& root) {
@@ -133,8 +204,12 @@ std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
 }
 
 std::string CameraPath::Spec() const {
-  return kind == Kind::kOrbit ? "orbit:" + std::to_string(frames)
-                              : "between:" + from + "," + to + "," + std::to_string(frames);
+  switch (kind) {
+    case Kind::kOrbit: return "orbit:" + std::to_string(frames);
+    case Kind::kPhotos: return "photos:" + std::to_string(frames);
+    case Kind::kBetween: break;
+  }
+  return "between:" + from + "," + to + "," + std::to_string(frames);
 }
 
 CameraPath ParseCameraPath(const std::string& spec) {
@@ -143,6 +218,9 @@ CameraPath ParseCameraPath(const std::string& spec) {
   const std::string rest = colon == std::string::npos ? "" : spec.substr(colon + 1);
   if (kind == "orbit" && colon != std::string::npos) {
     return {CameraPath::Kind::kOrbit, ParseCount(rest, spec), "", ""};
+  }
+  if (kind == "photos" && colon != std::string::npos) {
+    return {CameraPath::Kind::kPhotos, ParseCount(rest, spec), "", ""};
   }
   if (kind == "between" && colon != std::string::npos) {
     std::vector<std::string> parts;
@@ -153,7 +231,7 @@ CameraPath ParseCameraPath(const std::string& spec) {
     }
     return {CameraPath::Kind::kBetween, ParseCount(parts[2], spec), parts[0], parts[1]};
   }
-  throw BadInputError("--path " + spec + ": expected orbit:N or between:IMAGE_A,IMAGE_B,N");
+  throw BadInputError("--path " + spec + ": expected orbit:N, photos:N or between:IMAGE_A,IMAGE_B,N");
 }
 
 std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const fs::path& workspace_or_scene,
@@ -162,6 +240,9 @@ std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const fs::path
   const std::string spec = path.Spec();
   if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
   if (path.kind == CameraPath::Kind::kOrbit) return OrbitCameras(path.frames, workspace_or_scene, sources);
+  if (path.kind == CameraPath::Kind::kPhotos) {
+    return PhotoTourCameras(path.frames, ReadSceneFrame(workspace_or_scene, sources), sources, source_names);
+  }
   auto find = [&](const std::string& name) -> const PosedCamera& {
     for (size_t i = 0; i < source_names.size(); ++i) {
       if (source_names[i] == name || fs::path(source_names[i]).stem() == name) return sources[i];

@@ -31,13 +31,17 @@ std::vector<NamedCamera> CamerasFromModel(const std::filesystem::path& model_dir
 // A camera path among the sources, with the intrinsics of the first source:
 //   orbit:N          N cameras on the orbit `parallax view --orbit` follows (DefaultOrbit,
 //                    geometry/scene_frame.h, of the frame fitted to the workspace's mesh,
-//                    cloud and cameras): frame i is `view --orbit 360i/N` with the first
-//                    source's size and horizontal field of view. With cameras looking in at a
-//                    point, the circle about it at their median distance and elevation; else
-//                    one around the focus box;
-//   between:A,B,N    N cameras from source image A to B (pose interpolation, both included).
+//                    cloud and cameras): frame i is `view --orbit` at 360i/N degrees, or, when
+//                    the cameras stand on an arc that leaves a gap over 90 degrees, at i/(N-1)
+//                    of the way along that arc; with the first source's size and horizontal
+//                    field of view. With cameras looking in at a point, the circle about it at
+//                    their median distance and elevation; else one around the focus box;
+//   between:A,B,N    N cameras from source image A to B (pose interpolation, both included);
+//   photos:N         N cameras evenly along a smooth curve through every source camera (in
+//                    azimuth order about the point they look at, else in name order), from the
+//                    first to the last: a tour that stays where the photos were taken.
 struct CameraPath {
-  enum class Kind { kOrbit, kBetween };
+  enum class Kind { kOrbit, kBetween, kPhotos };
   Kind kind = Kind::kOrbit;
   int frames = 0;
   std::string from, to;  // kBetween: source image names or stems.

@@ -1,5 +1,6 @@
 // `parallax render --path orbit:N` and `parallax view --orbit` follow one circle: the scene
 // frame of geometry/scene_frame.h, fitted to the same workspace files.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
+#include "core/pose.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "geometry/obj.h"
@@ -165,6 +168,35 @@ TEST(Orbit, RenderOrbitKeepsToTheArcThePhotosWereTakenFrom) {
     EXPECT_GE(degrees, 0.3 * 180 / std::numbers::pi - 0.01);
     EXPECT_LE(degrees, 0.3 * 180 / std::numbers::pi + 100 + 0.01);
   }
+}
+
+// photos:N runs through the photo cameras in azimuth order (written here in another order),
+// from the first to the last, evenly by length and close to the circle they stand on.
+TEST(Orbit, PhotoTourRunsThroughThePhotoCameras) {
+  const TempDir dir;
+  const fs::path ws = dir.Path() / "ws";
+  WriteCameras(ws, 6, [](int index) { return ArcCamera((index * 5) % 6); });
+  WriteGeometry(ws);
+  const SourceLibrary library(SourcePathsFor(ws));
+  const std::vector<NamedCamera> tour =
+      CamerasAlongPath(ParseCameraPath("photos:21"), ws, library.Cameras(), library.Names());
+  ASSERT_EQ(tour.size(), 21u);
+  const auto centre = [&](size_t k) { return CameraCenter(tour[k].camera.cam_from_world); };
+  EXPECT_LT((centre(0) - CameraCenter(ArcCamera(0))).norm(), 1e-9);
+  EXPECT_LT((centre(20) - CameraCenter(ArcCamera(5))).norm(), 1e-9);
+  EXPECT_LT(RotationAngleDeg(tour[20].camera.cam_from_world.rotation, ArcCamera(5).rotation), 1e-6);
+  const Eigen::Vector3d ring_centre(0, 0, 2.5);
+  double shortest = 1e9, longest = 0;
+  for (size_t k = 0; k < tour.size(); ++k) {
+    EXPECT_NEAR((centre(k) - ring_centre).norm(), 6, 0.06) << k;  // Within 1% of the circle.
+    if (k == 0) continue;
+    const double step = (centre(k) - centre(k - 1)).norm();
+    shortest = std::min(shortest, step);
+    longest = std::max(longest, step);
+  }
+  EXPECT_LT(longest, 1.1 * shortest);
+  EXPECT_EQ(ParseCameraPath("photos:21").Spec(), "photos:21");
+  EXPECT_THROW(ParseCameraPath("photos:"), BadInputError);
 }
 
 TEST(Orbit, AzimuthArcIsTheCircleLessItsWidestGap) {
