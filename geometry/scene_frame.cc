@@ -138,11 +138,10 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
   if (!near_extent.contains(rig.target.cast<float>())) return std::nullopt;
   std::vector<double> distances, elevations, half_width_tans, azimuths;
   size_t in_front = 0;
-  const auto [u, v] = GroundAxes(up);
   for (const FrameCamera& camera : cameras) {
     in_front += (camera.cam_from_world * rig.target).z() > 0;
     const Eigen::Vector3d offset = CameraCenter(camera.cam_from_world) - rig.target;
-    azimuths.push_back(std::atan2(offset.dot(v), offset.dot(u)) * 180 / std::numbers::pi);
+    azimuths.push_back(AzimuthDeg(offset, up));
     distances.push_back(offset.norm());
     half_width_tans.push_back(0.5 * static_cast<double>(camera.camera.width) / camera.camera.FocalX());
     elevations.push_back(std::asin(std::clamp(up.dot(offset) / std::max(offset.norm(), 1e-12), -1.0, 1.0)) * 180 /
@@ -210,6 +209,12 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> GroundAxes(const Eigen::Vector3d& up
   const Eigen::Vector3d reference = std::abs(up.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d u = (reference - up * up.dot(reference)).normalized();
   return {u, up.cross(u)};
+}
+
+double AzimuthDeg(const Eigen::Vector3d& offset, const Eigen::Vector3d& up) {
+  const auto [u, v] = GroundAxes(up);
+  const double degrees = std::atan2(offset.dot(v), offset.dot(u)) * 180 / std::numbers::pi;
+  return degrees < 0 ? degrees + 360 : degrees;
 }
 
 Rigid3d OrbitPose(const Eigen::Vector3d& centre, const Eigen::Vector3d& up, double azimuth_deg,

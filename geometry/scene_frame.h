@@ -97,6 +97,10 @@ SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vect
 // possible: the directions of azimuth 0 and 90 degrees.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> GroundAxes(const Eigen::Vector3d& up);
 
+// The azimuth of `offset` about `up` (unit), in degrees in [0, 360): OrbitPose's azimuth of a
+// camera at centre + offset.
+double AzimuthDeg(const Eigen::Vector3d& offset, const Eigen::Vector3d& up);
+
 // A camera on a circle around `centre`: azimuth about `up` (0 along GroundAxes' first axis),
 // elevation above the plane normal to `up` (clamped to +-89), at `distance`, looking at
 // `centre` with its image up towards `up`.

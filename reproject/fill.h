@@ -41,7 +41,6 @@ struct FillOptions {
 
 struct FillSummary {
   int filled_px = 0;  // Pixels that received a color.
-  int from_sources_px = 0;  // Of those, hole pixels colored from the sources (from_sources).
   // Share of all pixels still without color after filling (holes nothing reached, and
   // out-of-view pixels when they are not filled). 0 when everything got a color.
   double hole_ratio_filled = 0;

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -88,12 +87,10 @@ std::vector<NamedCamera> OrbitCameras(int frames, const fs::path& root, const st
 std::vector<size_t> TourOrder(const SceneFrame& frame, const std::vector<PosedCamera>& sources,
                               const std::vector<std::string>& names) {
   std::vector<double> keys(sources.size());
-  for (size_t i = 0; i < sources.size(); ++i) {
-    if (!frame.rig) continue;
-    const auto [u, v] = GroundAxes(frame.up);
-    const Eigen::Vector3d offset = CameraCenter(sources[i].cam_from_world) - frame.rig->target;
-    const double azimuth = std::atan2(offset.dot(v), offset.dot(u)) * 180 / std::numbers::pi;
-    keys[i] = azimuth - frame.rig->arc_start_deg - 360 * std::floor((azimuth - frame.rig->arc_start_deg) / 360);
+  for (size_t i = 0; frame.rig && i < sources.size(); ++i) {
+    const double from_start =
+        AzimuthDeg(CameraCenter(sources[i].cam_from_world) - frame.rig->target, frame.up) - frame.rig->arc_start_deg;
+    keys[i] = from_start < 0 ? from_start + 360 : from_start;
   }
   std::vector<size_t> order(sources.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;

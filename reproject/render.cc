@@ -114,14 +114,14 @@ void Renderer::Finish(Clock::time_point start, double warp_ms, RenderResult* res
   timings.classify_ms = MsSince(step);
 
   step = Clock::now();
-  FillSummary fill = FillHoles(classes, target_.camera, options_.fill, &blend_);
+  const FillSummary fill = FillHoles(classes, target_.camera, options_.fill, &blend_);
   if (options_.fill.from_sources && options_.fill.method == FillMethod::kDepthAware) {
     std::vector<FillSource> fill_sources;
     for (size_t i = 0; i < sources_.size(); ++i) {
       fill_sources.push_back({sources_[i]->Posed(), &sources_[i]->color, &sources_[i]->depth,
                               &scratch_[i].Background()});
     }
-    fill.from_sources_px = FillFromSources(classes, target_, fill_sources, &blend_).colored_px;
+    FillFromSources(classes, target_, fill_sources, &blend_);
   }
   timings.fill_ms = MsSince(step);
 
