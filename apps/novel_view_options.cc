@@ -51,6 +51,9 @@ void AddNovelViewOptions(CLI::App& command, NovelViewSettings& settings) {
   command.add_flag("--no-fill-from-sources{false}", settings.render.fill.from_sources,
                    "depth-aware fill: keep the fill's color in holes whose continued surface a "
                    "source saw without depth, instead of that source's color");
+  command.add_flag("--no-fill-smoothing{false}", settings.render.fill.smooth,
+                   "depth-aware fill: keep the streaks of the hole's rim instead of averaging "
+                   "them over windows that grow with the distance to it");
 }
 
 }  // namespace parallax

@@ -33,6 +33,9 @@ struct FillOptions {
   // kDepthAware: holes whose filled surface some source saw without depth take that source's
   // color (FillFromSources, fill_from_sources.h).
   bool from_sources = true;
+  // kDepthAware: average the surface fills over windows that grow with the distance to the rim
+  // (no streaks fanning out from it).
+  bool smooth = true;
   // kInpaint: Telea neighbourhood radius in pixels, > 0.
   double inpaint_radius_px = 3;
 

@@ -257,5 +257,53 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
   EXPECT_GT(worst_edge_color, 0.02);  // What copying the edge would miss it by.
 }
 
+// A striped rim (red and blue bands 3 pixels wide, depth 5) along the top of a wide hole: each
+// march meets the rim at another band, so unsmoothed the fill fans out in streaks; smoothed, the
+// fill far from the rim is close to the rim's mean color and varies little from pixel to pixel,
+// while the rows beside the rim keep its bands.
+TEST(FillHoles, SmoothedSurfaceFillHasNoStreaks) {
+  constexpr int kSize = 64, kRim = 4;
+  const auto fill = [&](bool smooth) {
+    BlendResult blend;
+    blend.color.Reset(kSize, kSize, 3);
+    blend.depth.Reset(kSize, kSize);
+    blend.kind.assign(kSize * kSize, SampleKind::kNone);
+    ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kDisocclusion), {}};
+    for (int y = 0; y < kRim; ++y) {
+      for (int x = 0; x < kSize; ++x) {
+        const size_t i = static_cast<size_t>(y * kSize + x);
+        const Eigen::Vector3f& color = (x / 3) % 2 == 0 ? kBoxRed : kWallBlue;
+        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
+        blend.depth.Values()[i] = 5;
+        blend.kind[i] = SampleKind::kSurface;
+        classes.classes[i] = PixelClass::kCovered;
+      }
+    }
+    FillOptions options;
+    options.smooth = smooth;
+    FillHoles(classes, MakePinholeCamera(1, kSize, kSize, 64, 64, 32, 32), options, &blend);
+    return blend;
+  };
+  // Mean absolute difference of red between horizontal neighbours over rows [y0, y1).
+  const auto streaks = [&](const BlendResult& blend, int y0, int y1) {
+    double sum = 0;
+    int count = 0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = 8; x + 1 < kSize - 8; ++x) {
+        sum += static_cast<double>(std::abs(blend.color.At(x + 1, y, 0) - blend.color.At(x, y, 0)));
+        ++count;
+      }
+    }
+    return sum / count;
+  };
+  const BlendResult raw = fill(false), smooth = fill(true);
+  ASSERT_GT(streaks(raw, 24, 56), 0.02);
+  EXPECT_LT(streaks(smooth, 24, 56), 0.05 * streaks(raw, 24, 56));
+  const float rim_red = 0.5f * (kBoxRed(0) + kWallBlue(0));
+  EXPECT_NEAR(smooth.color.At(kSize / 2, 48, 0), rim_red, 0.03);
+  // Beside the rim the fill is left as the marches made it.
+  for (int x = 0; x < kSize; ++x) EXPECT_EQ(smooth.color.At(x, kRim, 0), raw.color.At(x, kRim, 0));
+}
+
 }  // namespace
 }  // namespace parallax
