@@ -38,8 +38,8 @@ void PrintSummary(const ReconstructSummary& summary, const std::filesystem::path
   }
   for (const std::string& line : summary.depth_resolution) std::printf("depth: %s\n", line.c_str());
   for (const std::string& note : summary.notes) std::printf("note: %s\n", note.c_str());
-  for (const std::string& warning : summary.warnings) {
-    std::fprintf(stderr, "WARNING: %s\n", warning.c_str());
+  for (size_t i = summary.warnings_said; i < summary.warnings.size(); ++i) {
+    std::fprintf(stderr, "WARNING: %s\n", summary.warnings[i].c_str());
   }
   if (!dry_run) std::printf("workspace: %s (report.json)\n", workspace.string().c_str());
 }

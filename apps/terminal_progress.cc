@@ -42,4 +42,11 @@ void TerminalProgress::Update(std::string_view stage, int64_t done, int64_t tota
   line_open_ = true;
 }
 
+void TerminalProgress::Warn(std::string_view message) {
+  if (line_open_) std::fputc('\n', stream_);
+  line_open_ = false;
+  std::fprintf(stream_, "WARNING: %.*s\n", static_cast<int>(message.size()), message.data());
+  std::fflush(stream_);
+}
+
 }  // namespace parallax

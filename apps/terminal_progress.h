@@ -14,6 +14,8 @@ class TerminalProgress final : public Progress {
   explicit TerminalProgress(std::FILE* stream = stderr);
   ~TerminalProgress() override;
   void Update(std::string_view stage, int64_t done, int64_t total) override;
+  // "WARNING: message" on a line of its own.
+  void Warn(std::string_view message) override;
 
  private:
   std::FILE* stream_;

@@ -70,6 +70,10 @@ struct MvsSummary {
   std::vector<std::string> skipped;  // Views without depth, and why.
   double photometric_seconds = 0;
   double geometric_seconds = 0;
+  // Views whose PatchMatch estimate, and whose filtered maps, an interrupted run of the same
+  // stage (same model and options) had written whole and this run kept.
+  int resumed_estimates = 0;
+  int resumed_filtered = 0;
 };
 
 // <ws>/depth/views.json and report.json's "depth" section: every field under its own name.
@@ -78,7 +82,7 @@ NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsViewReport, name, sources, mi
                                                 working_width, working_height, photometric_share,
                                                 geometric_share)
 NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(MvsSummary, views, skipped, photometric_seconds,
-                                                geometric_seconds)
+                                                geometric_seconds, resumed_estimates, resumed_filtered)
 
 // The views whose depth maps are written (`written`) and those PatchMatch runs on
 // (`estimated`): the written ones plus the sources the geometric filter checks them against.

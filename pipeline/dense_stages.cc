@@ -107,12 +107,12 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
   } else {
     for (const std::string& view : request.views) stage.outputs.push_back(workspace.Depth(view));
   }
-  stage.run = [workspace, request, every_view, summary, &progress] {
+  stage.run = [workspace, request, every_view, summary, key = stage.key, &progress] {
     const MvsOptions options = MvsOptionsOf(request);
     const MvsSummary mvs = request.collect_blocks ? FinishMultiViewStereoBlocks(workspace, options)
                            : request.stereo == StereoMethod::kSgbm
                                ? RunSgbmStereo(workspace, options.views, {}, progress)
-                               : RunMultiViewStereo(workspace, options, progress);
+                               : RunMultiViewStereo(workspace, options, key, progress);
     if (every_view) WriteFileAtomically(workspace.DepthViews(), nlohmann::json(mvs).dump(2) + "\n");
     if (summary) *summary = mvs;
   };

@@ -142,10 +142,50 @@ void FilterAndWriteBlock(const Workspace& ws, const SparseModel& model, const De
   progress.Update("filter", total, total);
 }
 
+// The depth stage key the estimates in <ws>/stereo/estimates were made for.
+fs::path EstimatesKeyFile(const Workspace& workspace) { return workspace.StereoEstimates() / "key.txt"; }
+
+// Whether `path` (an estimate, or a view's report) reads back whole.
+bool IsWhole(const fs::path& path) {
+  try {
+    if (path.extension() == ".json") return nlohmann::json::accept(ReadFileBytes(path));
+    return ReadColmapArray(path).channels == 5;
+  } catch (const BadInputError&) {
+    return false;
+  }
+}
+
 }  // namespace
 
-MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& options, Progress& progress) {
-  fs::remove_all(workspace.StereoEstimates());
+bool EstimatesMadeFor(const Workspace& workspace, const std::string& key) {
+  const fs::path key_file = EstimatesKeyFile(workspace);
+  return fs::exists(key_file) && ReadFileBytes(key_file) == key;
+}
+
+ResumedViews PrepareEstimates(const Workspace& workspace, const std::string& key) {
+  ResumedViews resumed;
+  if (!EstimatesMadeFor(workspace, key)) {
+    fs::remove_all(workspace.StereoEstimates());
+    fs::create_directories(workspace.StereoEstimates());
+    WriteFileAtomically(EstimatesKeyFile(workspace), key);
+    return resumed;
+  }
+  for (const auto& entry : fs::directory_iterator(workspace.StereoEstimates())) {
+    const fs::path& path = entry.path();
+    const bool estimate = path.extension() == ".bin", report = path.extension() == ".json";
+    if (!estimate && !report) continue;
+    if (!IsWhole(path)) {
+      fs::remove(path);
+      continue;
+    }
+    ++(estimate ? resumed.estimates : resumed.filtered);
+  }
+  return resumed;
+}
+
+MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& options, const std::string& key,
+                              Progress& progress) {
+  const ResumedViews resumed = PrepareEstimates(workspace, key);
   auto start = std::chrono::steady_clock::now();
   RunMultiViewStereoBlock(workspace, options, {MvsPass::kPhotometric}, progress);
   const double photometric_seconds = Seconds(start);
@@ -154,6 +194,8 @@ MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& opti
   MvsSummary summary = FinishMultiViewStereoBlocks(workspace, options);
   summary.photometric_seconds = photometric_seconds;
   summary.geometric_seconds = Seconds(start);
+  summary.resumed_estimates = resumed.estimates;
+  summary.resumed_filtered = resumed.filtered;
   return summary;
 }
 

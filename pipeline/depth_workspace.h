@@ -11,9 +11,24 @@
 
 namespace parallax {
 
+// What an interrupted depth stage left in <ws>/stereo/estimates that a new run can keep.
+struct ResumedViews {
+  int estimates = 0;  // Views' PatchMatch estimates.
+  int filtered = 0;   // Views' filtered maps (their reports).
+};
+
+// Readies <ws>/stereo/estimates for a depth stage with `key` (its hash of model and options):
+// kept when it was made for that key, with every estimate and report checked whole (a
+// damaged one is removed, and its view computed again); else emptied and marked with the key.
+ResumedViews PrepareEstimates(const Workspace& workspace, const std::string& key);
+// Whether <ws>/stereo/estimates was readied for `key`.
+bool EstimatesMadeFor(const Workspace& workspace, const std::string& key);
+
 // Reads <ws>/sparse and <ws>/images. Throws BadInputError for a missing model or image.
-// The same as every block of both passes, then FinishMultiViewStereoBlocks.
-MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& options, Progress& progress);
+// PrepareEstimates(key), every block of both passes, then FinishMultiViewStereoBlocks: a run
+// cut short resumes with the views it finished when run again with the same key.
+MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& options, const std::string& key,
+                              Progress& progress);
 
 // The depth stage in parts that separate processes can run: block `index` of `size`
 // consecutive views of one pass (size 0: every view). Every photometric block must be done

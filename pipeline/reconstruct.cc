@@ -207,6 +207,12 @@ void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, Sta
   const Stage depth = DepthStage(paths, undistort_key, depth_request, sfm.progress);
   graph.Run(depth);
   summary.depth = nlohmann::json::parse(ReadFileBytes(paths.DepthViews())).get<MvsSummary>();
+  const MvsSummary& mvs = *summary.depth;
+  if (!graph.Records().back().skipped && mvs.resumed_estimates + mvs.resumed_filtered > 0) {
+    summary.notes.push_back("depth: resumed a run cut short: kept " + std::to_string(mvs.resumed_estimates) +
+                            " views' PatchMatch estimates and " + std::to_string(mvs.resumed_filtered) +
+                            " views' filtered maps, computed the rest");
+  }
   std::string gains_note;
   const Stage color_gains = ColorGainsStage(paths, undistort_key, &gains_note);
   graph.Run(color_gains);
@@ -281,8 +287,15 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   ReconstructSummary summary;
   summary.images_found = static_cast<int>(photos.photos.size());
   summary.skipped_files = photos.skipped;
+  // Said now, so a run that fails later names them too.
   for (const SkippedFile& file : photos.skipped) {
     summary.warnings.push_back("skipped " + file.name + ": it " + file.reason);
+    progress.Warn(summary.warnings.back());
+  }
+  for (const Photo& photo : photos.photos) {
+    if (photo.non_finite.empty()) continue;
+    summary.warnings.push_back(photo.name + " has non-finite pixels: " + photo.non_finite);
+    progress.Warn(summary.warnings.back());
   }
   const int num_images = summary.images_found;
   const Workspace paths(workspace);
@@ -301,6 +314,11 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   if (!conversions.empty()) summary.notes.push_back(conversions);
 
   StageGraph graph(sfm.workspace, options.dry_run);
+  if (!graph.CacheDamage().empty()) {
+    summary.warnings.push_back(graph.CacheDamage());
+    progress.Warn(summary.warnings.back());
+  }
+  summary.warnings_said = summary.warnings.size();
   const Stage converted = PhotosStage(photos_dir, photos, paths, progress);
   graph.Run(converted);
   const Stage features = FeaturesStage(sfm, converted.key);

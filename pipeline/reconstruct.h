@@ -141,6 +141,8 @@ struct ReconstructSummary {
   std::vector<std::string> depth_resolution;
   std::vector<std::string> notes;  // Decisions worth knowing (e.g. a refinement kept or not).
   std::vector<std::string> warnings;
+  // The first warnings_said of them were said through Progress::Warn as they were found.
+  size_t warnings_said = 0;
 };
 
 // Runs (or with dry_run, plans) the SfM stages into `workspace`. Validates everything before

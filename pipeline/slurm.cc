@@ -11,6 +11,7 @@
 #include "core/workspace.h"
 #include "core/workspace_lock.h"
 #include "pipeline/dense_stages.h"
+#include "pipeline/depth_workspace.h"
 #include "pipeline/stage_graph.h"
 
 namespace parallax {
@@ -19,8 +20,6 @@ namespace {
 
 fs::path SlurmFolder(const Workspace& workspace) { return workspace.Root() / "slurm"; }
 fs::path DepthRequestFile(const Workspace& workspace) { return SlurmFolder(workspace) / "depth_request.json"; }
-// The depth stage key the estimates in <ws>/stereo/estimates were made for.
-fs::path EstimatesKeyFile(const Workspace& workspace) { return workspace.StereoEstimates() / "key.txt"; }
 
 std::string ShellQuote(const std::string& word) {
   std::string quoted = "'";
@@ -201,17 +200,16 @@ std::string RunDepthBlockStep(const fs::path& workspace, DepthBlockStep step, co
   }
   switch (step) {
     case DepthBlockStep::kPrepare: {
-      const fs::path key_file = EstimatesKeyFile(ws);
-      if (fs::exists(key_file) && ReadFileBytes(key_file) == depth.key) return "estimates kept: same model and options";
-      fs::remove_all(ws.StereoEstimates());
-      fs::create_directories(ws.StereoEstimates());
-      WriteFileAtomically(key_file, depth.key);
-      return "estimates cleared for depth key " + depth.key;
+      const ResumedViews resumed = PrepareEstimates(ws, depth.key);
+      if (resumed.estimates + resumed.filtered > 0) {
+        return "estimates kept: same model and options (" + std::to_string(resumed.estimates) + " estimates, " +
+               std::to_string(resumed.filtered) + " filtered views)";
+      }
+      return "estimates ready for depth key " + depth.key;
     }
     case DepthBlockStep::kPhotometric:
     case DepthBlockStep::kGeometric: {
-      const fs::path key_file = EstimatesKeyFile(ws);
-      if (!fs::exists(key_file) || ReadFileBytes(key_file) != depth.key) {
+      if (!EstimatesMadeFor(ws, depth.key)) {
         throw BadInputError(ws.StereoEstimates().string() + " was not prepared for this model and these options "
                             "(run `parallax depth-block " + workspace.string() + " prepare` after SfM)");
       }

@@ -12,8 +12,10 @@ StageCache::StageCache(std::filesystem::path file) : file_(std::move(file)) {
   try {
     const nlohmann::json json = nlohmann::json::parse(ReadFileBytes(file_));
     keys_ = json.get<std::map<std::string, std::string>>();
-  } catch (const std::exception&) {
+  } catch (const std::exception& error) {
     keys_.clear();  // Recomputing everything is always safe.
+    damage_ = file_.string() + " is damaged (" + error.what() +
+              "): no stage counts as done, every stage runs again";
   }
 }
 

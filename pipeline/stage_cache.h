@@ -12,8 +12,13 @@ namespace parallax {
 
 class StageCache {
  public:
-  // Loads `file` if it exists; an unreadable or corrupt file counts as "nothing done".
+  // Loads `file` if it exists; an unreadable or damaged file counts as "nothing done", and
+  // Damage() says so.
   explicit StageCache(std::filesystem::path file);
+
+  // What was wrong with the file and what that costs ("... every stage runs again"); empty
+  // when it was whole or absent.
+  const std::string& Damage() const { return damage_; }
 
   bool IsDone(const std::string& stage, const std::string& key) const;
   // The key `stage` last completed with, if any.
@@ -24,6 +29,7 @@ class StageCache {
  private:
   std::filesystem::path file_;
   std::map<std::string, std::string> keys_;
+  std::string damage_;
 };
 
 }  // namespace parallax

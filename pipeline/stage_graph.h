@@ -54,6 +54,8 @@ class StageGraph {
   std::optional<std::string> CompletedKey(const std::string& stage) const;
 
   bool DryRun() const { return dry_run_; }
+  // StageCache::Damage of the workspace's stages.json.
+  const std::string& CacheDamage() const { return cache_.Damage(); }
   const std::vector<StageRecord>& Records() const { return records_; }
 
  private:

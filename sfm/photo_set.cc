@@ -1,6 +1,7 @@
 #include "sfm/photo_set.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <tuple>
@@ -44,6 +45,22 @@ std::string ConversionNeeded(const OIIO::ImageSpec& spec, const std::string& for
   return text;
 }
 
+// The non-finite values among `pixels` and what the 8-bit conversion makes of them (NaN and
+// -Inf black, +Inf white, as OpenImageIO converts them); empty when every value is finite.
+std::string DescribeNonFinite(const std::vector<float>& pixels) {
+  size_t nan = 0, positive = 0, negative = 0;
+  for (const float value : pixels) {
+    if (std::isnan(value)) {
+      ++nan;
+    } else if (std::isinf(value)) {
+      ++(value > 0 ? positive : negative);
+    }
+  }
+  if (nan + positive + negative == 0) return "";
+  return std::to_string(nan) + " NaN and " + std::to_string(negative) + " -Inf values converted to 0 (black), " +
+         std::to_string(positive) + " +Inf values to 255 (white)";
+}
+
 }  // namespace
 
 // Decodes the whole file: a truncated image often has an intact header.
@@ -85,10 +102,20 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   if (focal_35mm > 0) {
     photo.exif_focal_px = static_cast<double>(focal_35mm) / 36.0 * std::max(spec.width, spec.height);
   }
-  std::vector<unsigned char> pixels(static_cast<size_t>(spec.width) * spec.height * spec.nchannels);
-  if (!input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data())) {
-    return "is corrupt or truncated (" + input->geterror() + ")";
+  input->geterror();  // Cleared: only what decoding says counts below.
+  const size_t values = static_cast<size_t>(spec.width) * static_cast<size_t>(spec.height) *
+                        static_cast<size_t>(spec.nchannels);
+  bool decoded = false;
+  if (spec.format.is_floating_point()) {
+    std::vector<float> pixels(values);
+    decoded = input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+    if (decoded) photo.non_finite = DescribeNonFinite(pixels);
+  } else {
+    std::vector<unsigned char> pixels(values);
+    decoded = input->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data());
   }
+  const std::string message = input->geterror();
+  if (!decoded || !message.empty()) return "is corrupt or truncated (" + message + ")";
   return std::nullopt;
 }
 

@@ -19,6 +19,9 @@ struct Photo {
   // Why COLMAP cannot read the file as it is ("16-bit", "grayscale", ...), so that it is
   // converted (sfm/photo_conversion.h); empty: the file is used as it is.
   std::string conversion;
+  // Non-finite pixels of a floating-point photo and what the conversion makes of them; empty
+  // when there are none.
+  std::string non_finite;
 };
 
 struct SkippedFile {
@@ -44,7 +47,9 @@ struct PhotoSet {
 };
 
 // Checks one photo as ScanPhotos does, decoding it whole: fills `photo`'s size, EXIF fields,
-// content hash and conversion (not its name). Returns why it cannot be used, if it cannot.
+// content hash, conversion and non-finite pixels (not its name). Returns why it cannot be used,
+// if it cannot: a decoder's warning counts (libjpeg decodes a truncated JPEG with a grey lower
+// half and only warns).
 std::optional<std::string> CheckPhoto(const std::filesystem::path& path, Photo& photo);
 
 // Scans `dir` (not recursively; hidden files ignored) and decodes every file to check it.

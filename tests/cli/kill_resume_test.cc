@@ -119,6 +119,13 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   const std::string stages = ReadFileBytes(workspace / "stages.json");
   EXPECT_EQ(stages.find("\"depth\""), std::string::npos) << "an interrupted stage is not done";
   ExpectEveryFileComplete(workspace);
+  // What the killed run finished: every view's PatchMatch estimate (the maps are written by the
+  // filter, after the last estimate) and some views' filtered maps (a report each, written
+  // after the maps).
+  const fs::path estimates = Workspace(workspace).StereoEstimates();
+  const size_t estimated = CountFiles(estimates, ".bin"), filtered = CountFiles(estimates, ".json");
+  EXPECT_EQ(estimated, 12u);
+  EXPECT_GE(filtered, 1u);
 
   // The killed run's lock went with it.
   const CliResult rerun = RunParallax("reconstruct " + Quote(photos) + " " + Quote(ws) + " --no-mesh");
@@ -132,6 +139,14 @@ TEST(KillResume, SigkillDuringDepthLosesNothingAndTheRerunCompletes) {
   EXPECT_TRUE(skipped.at("mapper"));
   EXPECT_TRUE(skipped.at("undistort"));
   EXPECT_FALSE(skipped.at("depth"));
+  // The depth stage resumes: what was written whole is kept, so at most the view in flight
+  // when the kill came is computed twice.
+  const nlohmann::json& depth = report.at("reconstruct").at("depth");
+  EXPECT_EQ(depth.at("resumed_estimates").get<size_t>(), estimated);
+  EXPECT_EQ(depth.at("resumed_filtered").get<size_t>(), filtered);
+  EXPECT_NE(rerun.output.find("depth: resumed a run cut short: kept " + std::to_string(estimated)),
+            std::string::npos)
+      << rerun.output;
   EXPECT_EQ(CountFiles(Workspace(workspace).DepthDir(), ".exr"), 24u);  // Depth + confidence per view.
   ExpectEveryFileComplete(workspace);
 }

@@ -3,6 +3,7 @@
 // those that need colmap's verdict on the photos run it on a few small ones.
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <string>
 
 #include <OpenImageIO/imagebuf.h>
@@ -10,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
 #include "tests/cli_runner.h"
@@ -214,6 +216,61 @@ TEST(ReconstructCli, PhotosInEveryFormACameraWritesAreReconstructed) {
   // A second run converts nothing again.
   const CliResult again = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast --dry-run"));
   EXPECT_NE(again.output.find("photos       skip"), std::string::npos) << again.output;
+}
+
+// A JPEG cut short and a float TIFF with NaN and infinite pixels among the arc's photos: the JPEG
+// is set aside, named as the scan finds it, and the others register; the TIFF is used, and
+// its non-finite pixels are named with what became of them. Then stages.json is cut short:
+// the next run names it and plans every stage again.
+TEST(ReconstructCli, ADamagedPhotoIsSetAsideAndADamagedStageCacheNamed) {
+  const TempDir dir;
+  const fs::path photos = dir.Path() / "photos";
+  fs::create_directories(photos);
+  for (int i = 0; i < kArcPhotos; ++i) {
+    const std::string stem = ArcStem(i);
+    OIIO::ImageBuf image((kCourtyardImages / (stem + ".png")).string());
+    if (i != 3) {
+      ASSERT_TRUE(image.write((photos / (stem + ".png")).string())) << image.geterror();
+      continue;
+    }
+    OIIO::ImageBuf hostile;
+    ASSERT_TRUE(OIIO::ImageBufAlgo::copy(hostile, image, OIIO::TypeDesc::FLOAT));
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const float values[3][3] = {{nan, nan, nan}, {inf, inf, inf}, {-inf, -inf, -inf}};
+    for (int k = 0; k < 3; ++k) hostile.setpixel(10 + k, 10, values[k]);
+    ASSERT_TRUE(hostile.write((photos / (stem + ".tif")).string(), OIIO::TypeDesc::FLOAT)) << hostile.geterror();
+  }
+  // A photo of the other side of the ring, its JPEG cut in the middle of the compressed pixels.
+  ASSERT_TRUE(OIIO::ImageBuf((kCourtyardImages / "0010.png").string()).write((dir.Path() / "whole.jpg").string()));
+  const std::string jpeg = ReadFileBytes(dir.Path() / "whole.jpg");
+  const size_t scan = jpeg.find("\xff\xda");
+  ASSERT_NE(scan, std::string::npos);
+  std::ofstream(photos / "0010.jpg", std::ios::binary)
+      .write(jpeg.data(), static_cast<std::streamsize>((scan + jpeg.size()) / 2));
+
+  const fs::path workspace = dir.Path() / "ws";
+  const CliResult result = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("registered 16/16 photos"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("WARNING: skipped 0010.jpg: it is corrupt or truncated (JPEG error: Premature end"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("WARNING: " + ArcStem(3) + ".tif has non-finite pixels: 3 NaN and 3 -Inf values "
+                               "converted to 0 (black), 3 +Inf values to 255 (white)"),
+            std::string::npos)
+      << result.output;
+  const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(workspace / "report.json"))["reconstruct"];
+  ASSERT_EQ(report["skipped_files"].size(), 1u);
+  EXPECT_EQ(report["skipped_files"][0]["name"], "0010.jpg");
+
+  const std::string stages = ReadFileBytes(workspace / "stages.json");
+  std::ofstream(workspace / "stages.json", std::ios::binary).write(stages.data(), static_cast<std::streamsize>(stages.size() / 2));
+  const CliResult again = RunParallax(Reconstruct(photos, workspace, "--no-depth --quality fast --dry-run"));
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("WARNING: " + (workspace / "stages.json").string() + " is damaged ("), std::string::npos)
+      << again.output;
+  EXPECT_NE(again.output.find("no stage counts as done, every stage runs again"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("features     will run"), std::string::npos) << again.output;
 }
 
 // Half the photos resized (another camera, or an editor's export): one camera per size, each

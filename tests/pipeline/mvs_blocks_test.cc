@@ -45,7 +45,7 @@ TEST(MvsBlocks, BlocksInAnyOrderAndRerunWriteWhatOneRunWrites) {
 
   MvsOptions options = MvsOptionsFor(Quality::kFast);
   options.max_image_size = 160;
-  const MvsSummary whole = RunMultiViewStereo(Workspace(one_run), options, progress);
+  const MvsSummary whole = RunMultiViewStereo(Workspace(one_run), options, "whole", progress);
   ASSERT_EQ(whole.views.size(), 12u);
 
   // Blocks of 5: the last photometric block first, the first geometric block twice (a

@@ -268,7 +268,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   // Half resolution: the maps keep the photos' size, lose some accuracy, stay unbiased.
   MvsOptions half = MvsOptionsFor(Quality::kBalanced);
   half.image_scale = 0.5;
-  RunMultiViewStereo(Workspace(workspace.Path()), half, progress);
+  RunMultiViewStereo(Workspace(workspace.Path()), half, "half scale", progress);
   EXPECT_EQ(ReadDepthExr(Workspace(workspace.Path()).Depth("0000.png")).Width(),
             static_cast<int>(truth.Cameras().front().width));
   const DepthEvaluation coarse =

@@ -4,9 +4,11 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <fstream>
+#include <limits>
 
 #include <gtest/gtest.h>
 
+#include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "sfm/photo_conversion.h"
@@ -168,6 +170,46 @@ TEST(PhotoConversion, AnUnreadableSourceIsNamed) {
     EXPECT_NE(std::string(error.what()).find("broken.png"), std::string::npos) << error.what();
   }
   EXPECT_FALSE(fs::exists(dir.Path() / "out.png"));
+}
+
+// A JPEG cut short decodes with a grey lower half and only a libjpeg warning: the scan skips it,
+// naming the warning. A float TIFF with NaN and infinite pixels is kept, and the scan says how
+// many there are and what the 8-bit conversion makes of them, which is what it writes.
+TEST(PhotoSet, TruncatedPhotosAreSkippedAndNonFinitePixelsNamed) {
+  const TempDir dir;
+  const OIIO::ImageBuf gradient = Gradient();
+  Write(gradient, dir.Path() / "whole.jpg", OIIO::TypeDesc::UINT8);
+  const std::string jpeg = ReadFileBytes(dir.Path() / "whole.jpg");
+  const size_t scan = jpeg.find("\xff\xda");  // The start of the compressed pixels.
+  ASSERT_NE(scan, std::string::npos);
+  std::ofstream(dir.Path() / "half.jpg", std::ios::binary)
+      .write(jpeg.data(), static_cast<std::streamsize>((scan + jpeg.size()) / 2));
+  OIIO::ImageBuf hostile(OIIO::ImageSpec(40, 20, 3, OIIO::TypeDesc::FLOAT));
+  OIIO::ImageBufAlgo::copy(hostile, gradient, OIIO::TypeDesc::FLOAT);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const float nan_pixel[3] = {nan, nan, nan}, positive[3] = {inf, inf, inf}, negative[3] = {-inf, -inf, -inf};
+  hostile.setpixel(1, 1, nan_pixel);
+  hostile.setpixel(2, 1, nan_pixel);
+  hostile.setpixel(3, 1, positive);
+  hostile.setpixel(4, 1, negative);
+  Write(hostile, dir.Path() / "hostile.tif", OIIO::TypeDesc::FLOAT);
+
+  const PhotoSet set = ScanPhotos(dir.Path());
+  ASSERT_EQ(set.skipped.size(), 1u);
+  EXPECT_EQ(set.skipped[0].name, "half.jpg");
+  EXPECT_NE(set.skipped[0].reason.find("is corrupt or truncated (JPEG error: Premature end of JPEG file"),
+            std::string::npos)
+      << set.skipped[0].reason;
+  EXPECT_EQ(Find(set, "whole.jpg").non_finite, "");
+  EXPECT_EQ(Find(set, "hostile.tif").non_finite,
+            "6 NaN and 3 -Inf values converted to 0 (black), 3 +Inf values to 255 (white)");
+  WriteReadablePhoto(dir.Path() / "hostile.tif", dir.Path() / "hostile.png");
+  const Image converted = ReadImage(dir.Path() / "hostile.png");
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(converted.At(1, 1, c), 0.0f);
+    EXPECT_EQ(converted.At(3, 1, c), 1.0f);
+    EXPECT_EQ(converted.At(4, 1, c), 0.0f);
+  }
 }
 
 }  // namespace
