@@ -95,8 +95,8 @@ std::optional<std::string> ExrHeaderProblem(const std::string& bytes, int64_t fi
       if (!(width >= 1 && height >= 1)) return "is corrupt: its data window is empty";
       if (OverPixelLimit(width, height)) {
         return "claims " + std::to_string(static_cast<int64_t>(width)) + "x" +
-               std::to_string(static_cast<int64_t>(height)) + " pixels, over the " +
-               std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded";
+               std::to_string(static_cast<int64_t>(height)) + " pixels, over " + PixelLimitName(width, height) +
+               "; not decoded";
       }
     }
     at += static_cast<size_t>(size);
@@ -133,6 +133,13 @@ std::optional<std::string> ImageHeaderProblem(const fs::path& path) {
   return png ? PngChunkProblem(bytes, file_size) : ExrHeaderProblem(bytes, file_size);
 }
 
+std::string PixelLimitName(double width, double height) {
+  if (width * height > kMaxImageMegapixels * 1e6) {
+    return "the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit";
+  }
+  return "the " + std::to_string(static_cast<int>(kMaxImageSide)) + " px side limit";
+}
+
 Image ReadImage(const fs::path& path) {
   // Keep alpha as stored: OpenImageIO would otherwise premultiply PNG color by alpha.
   OIIO::ImageSpec config;
@@ -152,8 +159,8 @@ Image ReadImage(const fs::path& path) {
   }
   if (OverPixelLimit(spec.width, spec.height)) {
     throw BadInputError("image " + path.string() + " is " + std::to_string(spec.width) + "x" +
-                        std::to_string(spec.height) + ", over the " +
-                        std::to_string(static_cast<int>(kMaxImageMegapixels)) + " MP limit; not decoded");
+                        std::to_string(spec.height) + ", over " + PixelLimitName(spec.width, spec.height) +
+                        "; not decoded");
   }
   Image image(spec.width, spec.height, spec.nchannels);
   // Integer formats are scaled to [0, 1] by OpenImageIO when read as float.

@@ -8,6 +8,7 @@
 //    caller converts explicitly with SrgbToLinear / LinearToSrgb.
 //  - Readers throw BadInputError naming the file and the problem; writers refuse NaN or Inf
 //    and write through a temporary file.
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -57,7 +58,15 @@ enum class PixelFormat { kUint8, kUint16, kHalf, kFloat };
 // images read, cameras rendered): no camera sensor is larger (medium format reaches 102 MP),
 // and a header claiming more is a decompression bomb or a scan or panorama to downscale.
 constexpr double kMaxImageMegapixels = 128;
-inline bool OverPixelLimit(double width, double height) { return width * height > kMaxImageMegapixels * 1e6; }
+// Nor a side longer than this (JPEG's own limit): OpenImageIO reads some formats in chunks of
+// rows allocated for the full width whatever the height (a 6-row BMP claiming 16.7 million
+// columns, 100 MP, asked for 12.8 GB).
+constexpr double kMaxImageSide = 65535;
+inline bool OverPixelLimit(double width, double height) {
+  return width * height > kMaxImageMegapixels * 1e6 || std::max(width, height) > kMaxImageSide;
+}
+// The limit width x height is over, as a phrase: "the 128 MP limit" or "the 65535 px side limit".
+std::string PixelLimitName(double width, double height);
 
 // What is wrong with a PNG or OpenEXR file's header, checked before a library reads it:
 // chunks and attributes that run past the end of the file, and data windows over

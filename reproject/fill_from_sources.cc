@@ -44,15 +44,16 @@ struct Lookup {
     if (!(fu >= 0 && fv >= 0 && fu < pinhole.width - 1 && fv < pinhole.height - 1)) return;
     const int x = static_cast<int>(fu), y = static_cast<int>(fv);
     const int nx = static_cast<int>(u), ny = static_cast<int>(v);
-    const float seen = source->depth->At(nx, ny);
+    const double seen = source->depth->At(nx, ny);
     if (seen > 0 ? std::abs(seen - local.z()) > kSameSurface * local.z() : IsSky(nx, ny)) return;
     const double angle = std::acos(std::clamp(target_ray.dot((point - centre).normalized()), -1.0, 1.0));
     const double w = 1 / (kMinAngleRad + angle);
     const double ax = fu - x, ay = fv - y;
     const Image& color = *source->color;
+    const auto at = [&](int px, int py, int c) { return static_cast<double>(color.At(px, py, c)); };
     for (int c = 0; c < 3; ++c) {
-      const double top = (1 - ax) * color.At(x, y, c) + ax * color.At(x + 1, y, c);
-      const double bottom = (1 - ax) * color.At(x, y + 1, c) + ax * color.At(x + 1, y + 1, c);
+      const double top = (1 - ax) * at(x, y, c) + ax * at(x + 1, y, c);
+      const double bottom = (1 - ax) * at(x, y + 1, c) + ax * at(x + 1, y + 1, c);
       rgb[c] += w * ((1 - ay) * top + ay * bottom);
     }
     *weight += w;

@@ -176,8 +176,7 @@ void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
   const std::string where = model_dir.string() + ": camera " + std::to_string(camera.id) + " of " + target.name;
   if (OverPixelLimit(static_cast<double>(camera.width), static_cast<double>(camera.height))) {
     throw BadInputError(where + " is " + std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                        ", over the " + std::to_string(static_cast<int>(kMaxImageMegapixels)) +
-                        " MP an image may have");
+                        ", over " + PixelLimitName(camera.width, camera.height) + " of an image");
   }
   try {
     RenderedCamera(target.camera);

@@ -86,7 +86,7 @@ std::vector<float> SolveLogGains(const std::vector<Observation>& observations, s
     for (size_t i = 0; i < photos; ++i) {
       if (residuals[i].empty()) continue;
       log_gain[i] = static_cast<float>(Median(residuals[i]));
-      mean += log_gain[i];
+      mean += static_cast<double>(log_gain[i]);
       ++counted;
     }
     mean /= static_cast<double>(std::max<size_t>(1, counted));
@@ -133,8 +133,8 @@ ColorGainsEstimate EstimateColorGains(const SparseModel& model, const fs::path& 
   }
   char note[160];
   std::snprintf(note, sizeof note, "%zu photos from %zu observations: gains %.3f to %.3f; %d photos kept 1 (too few usable points)",
-                estimate.gains.by_photo.size(), observations.size(), estimate.gains.by_photo.empty() ? 1.0 : lowest,
-                estimate.gains.by_photo.empty() ? 1.0 : highest, estimate.photos_without_gain);
+                estimate.gains.by_photo.size(), observations.size(), estimate.gains.by_photo.empty() ? 1.0 : static_cast<double>(lowest),
+                estimate.gains.by_photo.empty() ? 1.0 : static_cast<double>(highest), estimate.photos_without_gain);
   estimate.note = note;
   return estimate;
 }

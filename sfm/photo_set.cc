@@ -89,11 +89,10 @@ std::optional<std::string> CheckPhoto(const fs::path& path, Photo& photo) {
   if (spec.width < 16 || spec.height < 16) return "is too small to match (under 16 px)";
   const double megapixels = static_cast<double>(spec.width) * static_cast<double>(spec.height) / 1e6;
   if (OverPixelLimit(spec.width, spec.height)) {
-    char reason[160];
-    std::snprintf(reason, sizeof reason, "is %dx%d (%.0f MP), over the %.0f MP limit (a decompression bomb, or a "
-                  "scan or panorama to downscale first); not decoded", spec.width, spec.height, megapixels,
-                  kMaxImageMegapixels);
-    return std::string(reason);
+    char size[64];
+    std::snprintf(size, sizeof size, "is %dx%d (%.0f MP), over ", spec.width, spec.height, megapixels);
+    return size + PixelLimitName(spec.width, spec.height) +
+           " (a decompression bomb, or a scan or panorama to downscale first); not decoded";
   }
   const std::string make = spec.get_string_attribute("Make");
   const std::string model = spec.get_string_attribute("Model");

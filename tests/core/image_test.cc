@@ -145,6 +145,28 @@ TEST(Image, ExrHeadersClaimingTooMuchAreRefusedBeforeDecoding) {
   EXPECT_THROW(ReadImage(dir.Path() / "fuzzed.exr"), BadInputError);
 }
 
+// A 6-row BMP whose header claims 16,711,688 columns (100 MP, under the pixel limit), found by
+// fuzzing: OpenImageIO reads it in chunks of rows allocated for the full width, 12.8 GB. No
+// side may exceed JPEG's 65535 px.
+TEST(Image, ImagesWiderThanTheSideLimitAreRefusedBeforeDecoding) {
+  const TempDir dir;
+  const std::filesystem::path fuzzed = SourceDir() / "fuzz" / "corpus" / "image" /
+                                       "oom-3326eefd5a50c4f47e7c0f902837da248dc4e289";
+  std::ifstream input(fuzzed, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(input)), {});
+  std::ofstream(dir.Path() / "wide.bmp", std::ios::binary).write(bytes.data() + 1, static_cast<std::streamsize>(bytes.size() - 1));
+  try {
+    ReadImage(dir.Path() / "wide.bmp");
+    FAIL() << "read";
+  } catch (const BadInputError& error) {
+    EXPECT_NE(std::string(error.what()).find("is 16711688x6, over the 65535 px side limit"), std::string::npos)
+        << error.what();
+  }
+  EXPECT_TRUE(OverPixelLimit(65536, 16));
+  EXPECT_FALSE(OverPixelLimit(65535, 1953));  // 128 MP.
+  EXPECT_TRUE(OverPixelLimit(65535, 1954));
+}
+
 TEST(Image, WritingNanIsRefusedAndLeavesNoFile) {
   const TempDir dir;
   Image image(4, 4, 3);

@@ -102,25 +102,35 @@ TEST(FillHoles, OutOfViewIsLeftWhenAsked) {
   EXPECT_NEAR(result.fill.hole_ratio_filled, result.metrics.out_of_view_ratio, 1e-12);
 }
 
+// A width x height blend where nothing landed.
+BlendResult EmptyBlend(int width, int height) {
+  BlendResult blend;
+  blend.color.Reset(width, height, 3);
+  blend.depth.Reset(width, height);
+  blend.kind.assign(static_cast<size_t>(width) * static_cast<size_t>(height), SampleKind::kNone);
+  return blend;
+}
+
+// A sample of `color` landed at (x, y): a surface at `depth`, or background at infinity for
+// depth 0; its class is covered or background.
+void Land(int x, int y, const Eigen::Vector3f& color, float depth, BlendResult* blend, ClassMap* classes) {
+  const size_t i = static_cast<size_t>(y) * static_cast<size_t>(classes->width) + static_cast<size_t>(x);
+  for (int ch = 0; ch < 3; ++ch) blend->color.At(x, y, ch) = color(ch);
+  blend->depth.Values()[i] = depth;
+  blend->kind[i] = depth > 0 ? SampleKind::kSurface : SampleKind::kBackground;
+  classes->classes[i] = depth > 0 ? PixelClass::kCovered : PixelClass::kBackground;
+}
+
 // One row holds two samples, at its two ends, and nothing else anywhere: only the marches
 // along the row find them (as a lookup of the row's nearest samples, not a walk), and each
 // counts with 1 / its distance. Both at one depth, so both are blended.
 TEST(FillHoles, MarchesAlongTheRowWeighTheirSamplesByDistance) {
   constexpr int kWidth = 40, kHeight = 9, kRow = 4;
-  BlendResult blend;
-  blend.color.Reset(kWidth, kHeight, 3);
-  blend.depth.Reset(kWidth, kHeight);
-  blend.kind.assign(kWidth * kHeight, SampleKind::kNone);
+  BlendResult blend = EmptyBlend(kWidth, kHeight);
   ClassMap classes{kWidth, kHeight,
                    std::vector<PixelClass>(kWidth * kHeight, PixelClass::kDisocclusion), {}};
-  for (int x : {0, kWidth - 1}) {
-    const size_t i = static_cast<size_t>(kRow * kWidth + x);
-    const Eigen::Vector3f& color = x == 0 ? kBoxRed : kWallBlue;
-    for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
-    blend.depth.Values()[i] = 3;
-    blend.kind[i] = SampleKind::kSurface;
-    classes.classes[i] = PixelClass::kCovered;
-  }
+  Land(0, kRow, kBoxRed, 3, &blend, &classes);
+  Land(kWidth - 1, kRow, kWallBlue, 3, &blend, &classes);
   const FillSummary summary =
       FillHoles(classes, MakePinholeCamera(1, kWidth, kHeight, 40, 40, 20, 4.5), {}, &blend);
   // Pixel 20 of the row is 20 from the red sample and 19 from the blue one; beside either end
@@ -140,25 +150,14 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
   constexpr int kSize = 40, kGround = 30;
   const Eigen::Vector3f sky(0.5f, 0.6f, 0.9f);
   const auto fill = [&](bool open_to_sky, double share) {
-    BlendResult blend;
-    blend.color.Reset(kSize, kSize, 3);
-    blend.depth.Reset(kSize, kSize);
-    blend.kind.assign(kSize * kSize, SampleKind::kNone);
-    ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kCovered),
+    BlendResult blend = EmptyBlend(kSize, kSize);
+    ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kDisocclusion),
                      std::vector<uint8_t>(kSize * kSize, open_to_sky ? 1 : 0)};
     for (int y = 0; y < kSize; ++y) {
       for (int x = 0; x < kSize; ++x) {
-        const size_t i = static_cast<size_t>(y * kSize + x);
-        if (x >= 15 && x < 25 && y >= 20 && y < kGround) {
-          classes.classes[i] = PixelClass::kDisocclusion;
-          continue;
-        }
+        if (x >= 15 && x < 25 && y >= 20 && y < kGround) continue;
         const bool ground = y >= kGround;
-        const Eigen::Vector3f& color = ground ? kWallBlue : sky;
-        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
-        blend.depth.Values()[i] = ground ? 5.0f : 0.0f;
-        blend.kind[i] = ground ? SampleKind::kSurface : SampleKind::kBackground;
-        classes.classes[i] = ground ? PixelClass::kCovered : PixelClass::kBackground;
+        Land(x, y, ground ? kWallBlue : sky, ground ? 5.0f : 0.0f, &blend, &classes);
       }
     }
     FillOptions options;
@@ -190,20 +189,12 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
 TEST(FillHoles, OutOfViewBelowTheSkyContinuesTheSurface) {
   constexpr int kSize = 64, kSkyRows = 16;
   const Eigen::Vector3f sky(0.5f, 0.6f, 0.9f), wall(0.4f, 0.4f, 0.4f);
-  BlendResult blend;
-  blend.color.Reset(kSize, kSize, 3);
-  blend.depth.Reset(kSize, kSize);
-  blend.kind.assign(kSize * kSize, SampleKind::kNone);
+  BlendResult blend = EmptyBlend(kSize, kSize);
   ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kOutOfView), {}};
   for (int y = 0; y < kSize; ++y) {
     for (int x = kSize / 2; x < kSize; ++x) {
-      const size_t i = static_cast<size_t>(y * kSize + x);
       const bool is_sky = y < kSkyRows;
-      const Eigen::Vector3f& color = is_sky ? sky : wall;
-      for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
-      blend.depth.Values()[i] = is_sky ? 0.0f : 5.0f;
-      blend.kind[i] = is_sky ? SampleKind::kBackground : SampleKind::kSurface;
-      classes.classes[i] = is_sky ? PixelClass::kBackground : PixelClass::kCovered;
+      Land(x, y, is_sky ? sky : wall, is_sky ? 0.0f : 5.0f, &blend, &classes);
     }
   }
   FillHoles(classes, MakePinholeCamera(1, kSize, kSize, 64, 64, 32, 32), {}, &blend);
@@ -264,20 +255,10 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
 TEST(FillHoles, SmoothedSurfaceFillHasNoStreaks) {
   constexpr int kSize = 64, kRim = 4;
   const auto fill = [&](bool smooth) {
-    BlendResult blend;
-    blend.color.Reset(kSize, kSize, 3);
-    blend.depth.Reset(kSize, kSize);
-    blend.kind.assign(kSize * kSize, SampleKind::kNone);
+    BlendResult blend = EmptyBlend(kSize, kSize);
     ClassMap classes{kSize, kSize, std::vector<PixelClass>(kSize * kSize, PixelClass::kDisocclusion), {}};
     for (int y = 0; y < kRim; ++y) {
-      for (int x = 0; x < kSize; ++x) {
-        const size_t i = static_cast<size_t>(y * kSize + x);
-        const Eigen::Vector3f& color = (x / 3) % 2 == 0 ? kBoxRed : kWallBlue;
-        for (int ch = 0; ch < 3; ++ch) blend.color.Pixels()[3 * i + static_cast<size_t>(ch)] = color(ch);
-        blend.depth.Values()[i] = 5;
-        blend.kind[i] = SampleKind::kSurface;
-        classes.classes[i] = PixelClass::kCovered;
-      }
+      for (int x = 0; x < kSize; ++x) Land(x, y, (x / 3) % 2 == 0 ? kBoxRed : kWallBlue, 5, &blend, &classes);
     }
     FillOptions options;
     options.smooth = smooth;
