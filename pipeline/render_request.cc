@@ -59,6 +59,7 @@ void EstimateMissingDepth(const Workspace& workspace, const SourceLibrary& libra
   // reconstruct's, at reconstruct's default quality.
   lock.MakeExclusive();
   StageGraph graph(workspace, false);
+  if (!graph.CacheDamage().empty()) progress.Warn(graph.CacheDamage());
   DepthRequest request;
   request.views.assign(missing.begin(), missing.end());
   MvsSummary mvs;

@@ -463,6 +463,7 @@ void SmoothSurfaceFill(const ClassMap& classes, const FillOptions& options, Blen
       const float t = level - static_cast<float>(low);
       const cv::Vec3f mean = (1 - t) * PyramidMean(pyramid[static_cast<size_t>(low)], width, height, x, y) +
                              t * PyramidMean(pyramid[static_cast<size_t>(high)], width, height, x, y);
+      if (!std::isfinite(mean[0] + mean[1] + mean[2])) continue;  // No weight: keep the fill's color.
       for (int ch = 0; ch < 3; ++ch) blend->color.At(x, y, ch) = mean[ch];
     }
   });
