@@ -7,15 +7,17 @@ namespace parallax {
 TerminalProgress::TerminalProgress(std::FILE* stream)
     : stream_(stream), interactive_(::isatty(::fileno(stream)) != 0) {}
 
-TerminalProgress::~TerminalProgress() {
+TerminalProgress::~TerminalProgress() { CloseLine(); }
+
+void TerminalProgress::CloseLine() {
   if (line_open_) std::fputc('\n', stream_);
+  line_open_ = false;
 }
 
 void TerminalProgress::Update(std::string_view stage, int64_t done, int64_t total) {
   const auto now = std::chrono::steady_clock::now();
   if (stage != stage_) {
-    if (line_open_) std::fputc('\n', stream_);
-    line_open_ = false;
+    CloseLine();
     stage_reported_ = false;
     stage_ = stage;
     stage_start_ = now;
@@ -43,8 +45,7 @@ void TerminalProgress::Update(std::string_view stage, int64_t done, int64_t tota
 }
 
 void TerminalProgress::Warn(std::string_view message) {
-  if (line_open_) std::fputc('\n', stream_);
-  line_open_ = false;
+  CloseLine();
   std::fprintf(stream_, "WARNING: %.*s\n", static_cast<int>(message.size()), message.data());
   std::fflush(stream_);
 }

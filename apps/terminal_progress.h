@@ -18,6 +18,9 @@ class TerminalProgress final : public Progress {
   void Warn(std::string_view message) override;
 
  private:
+  // Ends a redrawn line with its newline, if one is open.
+  void CloseLine();
+
   std::FILE* stream_;
   std::string stage_;
   std::chrono::steady_clock::time_point stage_start_;

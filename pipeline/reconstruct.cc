@@ -287,15 +287,15 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   ReconstructSummary summary;
   summary.images_found = static_cast<int>(photos.photos.size());
   summary.skipped_files = photos.skipped;
-  // Said now, so a run that fails later names them too.
-  for (const SkippedFile& file : photos.skipped) {
-    summary.warnings.push_back("skipped " + file.name + ": it " + file.reason);
-    progress.Warn(summary.warnings.back());
-  }
+  // What the input holds is said as it is found, so a run that fails later names it too.
+  const auto warn_now = [&](const std::string& warning) {
+    progress.Warn(warning);
+    summary.warnings.push_back(warning);
+    summary.warnings_said = summary.warnings.size();
+  };
+  for (const SkippedFile& file : photos.skipped) warn_now("skipped " + file.name + ": it " + file.reason);
   for (const Photo& photo : photos.photos) {
-    if (photo.non_finite.empty()) continue;
-    summary.warnings.push_back(photo.name + " has non-finite pixels: " + photo.non_finite);
-    progress.Warn(summary.warnings.back());
+    if (!photo.non_finite.empty()) warn_now(photo.name + " has non-finite pixels: " + photo.non_finite);
   }
   const int num_images = summary.images_found;
   const Workspace paths(workspace);
@@ -314,11 +314,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
   if (!conversions.empty()) summary.notes.push_back(conversions);
 
   StageGraph graph(sfm.workspace, options.dry_run);
-  if (!graph.CacheDamage().empty()) {
-    summary.warnings.push_back(graph.CacheDamage());
-    progress.Warn(summary.warnings.back());
-  }
-  summary.warnings_said = summary.warnings.size();
+  if (!graph.CacheDamage().empty()) warn_now(graph.CacheDamage());
   const Stage converted = PhotosStage(photos_dir, photos, paths, progress);
   graph.Run(converted);
   const Stage features = FeaturesStage(sfm, converted.key);
