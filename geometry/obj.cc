@@ -14,6 +14,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
+#include "geometry/glb.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -123,6 +124,7 @@ void WriteTexturedMesh(const fs::path& dir, const TriangleMesh& mesh) {
   WriteFileAtomically(temporary / "mesh.mtl",
                       "newmtl atlas\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nillum 1\nmap_Kd mesh.png\n");
   WriteImage(temporary / "mesh.png", mesh.atlas, PixelFormat::kUint8);
+  WriteGlb(temporary / "mesh.glb", mesh, ReadFileBytes(temporary / "mesh.png"));
   fs::remove_all(dir);
   fs::rename(temporary, dir);
 }

@@ -11,8 +11,9 @@
 
 namespace parallax {
 
-// Writes <dir>/mesh.obj, mesh.mtl and mesh.png through a temporary folder renamed into place,
-// so a reader never sees a mix of old and new files.
+// Writes <dir>/mesh.obj, mesh.mtl and mesh.png, and the same mesh as one binary glTF file,
+// mesh.glb (geometry/glb.h), through a temporary folder renamed into place, so a reader never
+// sees a mix of old and new files.
 void WriteTexturedMesh(const std::filesystem::path& dir, const TriangleMesh& mesh);
 
 // Reads an OBJ (tinyobjloader) with triangles whose corners all have texture coordinates, and

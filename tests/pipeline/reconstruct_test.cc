@@ -246,6 +246,13 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_NE(assimp.output.find("Faces:"), std::string::npos) << assimp.output;
   EXPECT_NE(assimp.output.find(std::to_string(mesh.triangles.size())), std::string::npos)
       << assimp.output;
+  // The same mesh as binary glTF: valid for the Khronos validator, as many triangles.
+  const std::filesystem::path glb = Workspace(workspace.Path()).MeshDir() / "mesh.glb";
+  const CliResult validator = RunCommand(Quote((SourceDir() / "scripts" / "validate-glb").string()) + " " + Quote(glb.string()));
+  EXPECT_EQ(validator.exit_code, 0) << validator.output;
+  EXPECT_NE(validator.output.find("\"errors\":0,\"warnings\":0,"), std::string::npos) << validator.output;
+  EXPECT_NE(validator.output.find("\"triangles\":" + std::to_string(mesh.triangles.size()) + ","), std::string::npos)
+      << validator.output;
 
   // The OpenCV StereoSGBM baseline on the same workspace (it overwrites depth/): it works on
   // rectified pairs of these converging cameras, and PatchMatch beats it.
