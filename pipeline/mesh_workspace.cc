@@ -47,10 +47,12 @@ TriangleMesh TrimmedPoissonSurface(const Workspace& workspace, const Colmap& col
   }
   const fs::path poisson = workspace.PoissonMesh();
   const fs::path temporary = workspace.PoissonMeshScratch();
+  // One thread: Poisson's threads sum in no fixed order, and the same cloud would give
+  // another mesh each run.
   colmap.Run("poisson_mesher",
              {"--input_path", fused.string(), "--output_path", temporary.string(),
               "--PoissonMeshing.depth", std::to_string(options.poisson_depth), "--PoissonMeshing.trim",
-              std::to_string(options.poisson_trim)},
+              std::to_string(options.poisson_trim), "--PoissonMeshing.num_threads", "1"},
              workspace.Log("mesh"), "mesh", 0, progress);
   fs::rename(temporary, poisson);
 

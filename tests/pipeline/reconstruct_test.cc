@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <OpenImageIO/imagebuf.h>
 
+#include "core/atomic_file.h"
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "core/scene_folder.h"
@@ -22,6 +23,7 @@
 #include "mvs/sgbm.h"
 #include "pipeline/depth_workspace.h"
 #include "pipeline/fusion_workspace.h"
+#include "pipeline/mesh_workspace.h"
 #include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "eval/depth_evaluation.h"
@@ -253,6 +255,13 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_NE(validator.output.find("\"errors\":0,\"warnings\":0,"), std::string::npos) << validator.output;
   EXPECT_NE(validator.output.find("\"triangles\":" + std::to_string(mesh.triangles.size()) + ","), std::string::npos)
       << validator.output;
+  // The mesh stage again on the same cloud, twice: the same files byte for byte (colmap's
+  // Poisson runs on one thread, whose sums come in a fixed order).
+  const MeshOptions mesh_options = MeshOptionsFor(Quality::kFast);
+  MeshWorkspace(Workspace(workspace.Path()), Colmap(), mesh_options, progress);
+  const std::string first = ReadFileBytes(obj);
+  MeshWorkspace(Workspace(workspace.Path()), Colmap(), mesh_options, progress);
+  EXPECT_TRUE(ReadFileBytes(obj) == first) << "the same cloud meshed twice gave two meshes";
 
   // The OpenCV StereoSGBM baseline on the same workspace (it overwrites depth/): it works on
   // rectified pairs of these converging cameras, and PatchMatch beats it.
