@@ -112,6 +112,27 @@ void PrintNovel(const NovelViewsEvaluation& novel) {
               result.sources_total, novel.comparison_dir.string().c_str());
 }
 
+// The textured mesh at the held-out cameras: whole frames (missed pixels black), the pixels it
+// covers, and those another run's mesh covers too.
+void PrintMeshHeldOut(const TexturedMeshScore& mesh, const std::filesystem::path& dir, bool common) {
+  std::printf("%-16s %9s %7s %14s %9s", "textured mesh", "PSNR (dB)", "SSIM", "covered (dB)", "covered");
+  if (common) std::printf(" %17s %7s", "both cover (dB)", "share");
+  std::printf("\n");
+  for (const TexturedMeshView& view : mesh.per_view) {
+    std::printf("%-16s %9.2f %7.3f %14.2f %8.1f%%", view.name.c_str(), view.psnr, view.ssim, view.psnr_covered,
+                100 * view.coverage);
+    if (common) std::printf(" %17.2f %6.1f%%", view.psnr_common, 100 * view.common_share);
+    std::printf("\n");
+  }
+  std::printf("textured mesh at the held-out cameras: PSNR %.2f dB, SSIM %.3f (whole frames); %.2f dB on the "
+              "%.1f%% it covers",
+              mesh.frame_psnr_mean, mesh.frame_ssim_mean, mesh.psnr_mean, 100 * mesh.coverage_mean);
+  if (common) {
+    std::printf("; %.2f dB on the %.1f%% both meshes cover", mesh.common_psnr_mean, 100 * mesh.common_share_mean);
+  }
+  std::printf(" (%s)\n", dir.string().c_str());
+}
+
 }  // namespace
 
 void RegisterEvaluateCommand(CLI::App& app) {
@@ -154,6 +175,10 @@ void RegisterEvaluateCommand(CLI::App& app) {
                       "photos give poses only) or from the ground truth through the pose "
                       "alignment (aligned)")
       ->transform(CLI::CheckedTransformer(novel_poses, CLI::ignore_case));
+  command->add_option("--mesh-common-with", arguments->options.mesh_common_with,
+                      "another workspace evaluated at the same held-out photos (a baseline's): also score "
+                      "the textured mesh on the pixels both meshes cover")
+      ->check(CLI::ExistingDirectory);
   AddNovelViewOptions(*command, arguments->options.novel);
   command->callback([arguments] {
     arguments->options.align = !arguments->no_align;
@@ -176,6 +201,10 @@ void RegisterEvaluateCommand(CLI::App& app) {
     PrintDepth(evaluation, workspace);
     PrintCloudAndMesh(evaluation);
     if (evaluation.novel) PrintNovel(*evaluation.novel);
+    if (evaluation.mesh_held_out) {
+      PrintMeshHeldOut(*evaluation.mesh_held_out, evaluation.mesh_held_out_dir,
+                       !arguments->options.mesh_common_with.empty());
+    }
     const std::filesystem::path out =
         arguments->json.empty() ? EvaluationLayout(workspace.Root()).Json() : arguments->json;
     WriteFileAtomically(out, nlohmann::json(evaluation).dump(2) + "\n");

@@ -14,6 +14,7 @@ class EvaluationLayout {
   std::filesystem::path Dir() const { return root_ / "evaluation"; }
   std::filesystem::path DepthErrorImages() const { return Dir() / "depth_error"; }
   std::filesystem::path MeshRenders() const { return Dir() / "mesh_render"; }
+  std::filesystem::path MeshHeldOutRenders() const { return Dir() / "mesh_held_out"; }
   std::filesystem::path NovelRegistration() const { return Dir() / "novel_registration"; }
   std::filesystem::path NovelComparisons(bool ground_truth_sources) const {
     return Dir() / (ground_truth_sources ? "novel_gt_sources" : "novel");

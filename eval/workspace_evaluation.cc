@@ -47,9 +47,25 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
     result.accuracy = MeasureCloud(mesh.vertices, truth, scene.Training().depth, truth_from_estimate);
   }
   result.render_dir = EvaluationLayout(workspace.Root()).MeshRenders();
-  result.texture = ScoreTexturedMesh(mesh, estimate, ReadWorkspaceColorGains(workspace.Root()), workspace.Images(),
+  std::vector<std::string> names;
+  const std::vector<NamedCamera> cameras = CamerasOfModel(estimate, &names);
+  result.texture = ScoreTexturedMesh(mesh, cameras, names, ReadWorkspaceColorGains(workspace.Root()), workspace.Images(),
                                      result.render_dir);
   return result;
+}
+
+// The workspace's textured mesh at the novel cameras `targets`, photos `names` in `images`,
+// into `evaluation`; nothing when the workspace has no mesh.
+void ScoreMeshAtNovelCameras(const Workspace& workspace, const std::vector<NamedCamera>& targets,
+                             const std::vector<std::string>& names, const fs::path& images,
+                             const EvaluateOptions& options, WorkspaceEvaluation& evaluation) {
+  if (!fs::exists(workspace.Mesh())) return;
+  evaluation.mesh_held_out_dir = EvaluationLayout(workspace.Root()).MeshHeldOutRenders();
+  const fs::path common =
+      options.mesh_common_with.empty() ? fs::path() : EvaluationLayout(options.mesh_common_with).MeshHeldOutRenders();
+  evaluation.mesh_held_out = ScoreTexturedMesh(ReadTexturedMesh(workspace.Mesh()), targets, names,
+                                               ReadWorkspaceColorGains(workspace.Root()), images,
+                                               evaluation.mesh_held_out_dir, common);
 }
 
 // `targets` rendered from the sources (the workspace's, or with options.gt_sources the
@@ -74,7 +90,8 @@ void RenderAndCompare(const Workspace& workspace, ViewSetPaths sources, const st
 // images.
 NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder& scene,
                                    const EvaluateOptions& options,
-                                   const Similarity3d& truth_from_estimate, Progress& progress) {
+                                   const Similarity3d& truth_from_estimate, Progress& progress,
+                                   std::vector<NamedCamera>* targets_out, std::vector<std::string>* names_out) {
   NovelViewsEvaluation evaluation;
   evaluation.gt_sources = options.gt_sources;
   const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
@@ -107,6 +124,8 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
   }
   RenderAndCompare(workspace, options.gt_sources ? scene.Training() : SourcePathsFor(workspace.Root()), targets,
                    names, scene.Novel(), options, evaluation);
+  *targets_out = std::move(targets);
+  *names_out = std::move(names);
   return evaluation;
 }
 
@@ -155,7 +174,11 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
     evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate, truth_depth);
   }
   if (fs::is_directory(scene.Novel().sparse) && (options.gt_sources || has_depth)) {
-    evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate, progress);
+    std::vector<NamedCamera> targets;
+    std::vector<std::string> names;
+    evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate, progress, &targets, &names);
+    // The ground-truth sources' cameras are in the scene's frame, not the mesh's.
+    if (!options.gt_sources) ScoreMeshAtNovelCameras(workspace, targets, names, scene.Novel().images, options, evaluation);
   }
   evaluation.reconstruct_timings_s = ReconstructTimings(workspace);
   return evaluation;
@@ -197,6 +220,7 @@ WorkspaceEvaluation EvaluateHeldOut(const Workspace& workspace, const EvaluateOp
   ViewSetPaths truth;
   truth.images = held_out.Images();
   RenderAndCompare(workspace, SourcePathsFor(workspace.Root()), targets, names, truth, options, novel);
+  ScoreMeshAtNovelCameras(workspace, targets, names, truth.images, options, evaluation);
   evaluation.reconstruct_timings_s = ReconstructTimings(workspace);
   return evaluation;
 }
@@ -252,6 +276,29 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                           {"hole_ratio", view.hole_ratio},
                           {"sources", view.sources},
                           {"budget", BudgetJson(view.budget)}});
+    }
+  }
+  if (evaluation.mesh_held_out) {
+    const TexturedMeshScore& mesh = *evaluation.mesh_held_out;
+    json["mesh_held_out"] = {{"psnr_mean", mesh.frame_psnr_mean},
+                             {"ssim_mean", mesh.frame_ssim_mean},
+                             {"covered_psnr_mean", mesh.psnr_mean},
+                             {"coverage_mean", mesh.coverage_mean}};
+    nlohmann::json& per_view = json["mesh_held_out"]["per_view"] = nlohmann::json::array();
+    for (const TexturedMeshView& view : mesh.per_view) {
+      per_view.push_back({{"name", view.name},
+                          {"psnr", view.psnr},
+                          {"ssim", view.ssim},
+                          {"covered_psnr", view.psnr_covered},
+                          {"coverage", view.coverage}});
+      if (view.common_share > 0) {
+        per_view.back()["common_psnr"] = view.psnr_common;
+        per_view.back()["common_share"] = view.common_share;
+      }
+    }
+    if (mesh.common_share_mean > 0) {
+      json["mesh_held_out"]["common_psnr_mean"] = mesh.common_psnr_mean;
+      json["mesh_held_out"]["common_share_mean"] = mesh.common_share_mean;
     }
   }
   if (!evaluation.not_scored.empty()) json["not_scored"] = evaluation.not_scored;

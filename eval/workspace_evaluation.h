@@ -38,6 +38,9 @@ struct EvaluateOptions {
   bool novel_only = false;
   NovelPoses novel_poses = NovelPoses::kRegistered;
   NovelViewSettings novel;
+  // Another workspace evaluated at the same held-out cameras: the textured mesh is also scored
+  // on the pixels both meshes cover (its evaluation/mesh_held_out/<name>.covered.png).
+  std::filesystem::path mesh_common_with;
 };
 
 struct MeshEvaluation {
@@ -75,6 +78,10 @@ struct WorkspaceEvaluation {
   // scored.
   std::vector<std::string> not_scored;
   std::optional<NovelViewsEvaluation> novel;
+  // The textured mesh rendered at the novel (held-out) cameras, beside the warped views; when
+  // the workspace has a mesh and the views are rendered from its sources.
+  std::optional<TexturedMeshScore> mesh_held_out;
+  std::filesystem::path mesh_held_out_dir;
   // Stage timings from reconstruct's report.json, when the workspace has them.
   std::optional<std::map<std::string, double>> reconstruct_timings_s;
 };

@@ -95,6 +95,28 @@ TEST(HeldOut, HeldOutPhotosAreRegisteredKeptOutOfTheDenseStagesAndScored) {
   EXPECT_EQ(scores["views"], 4);
   for (const nlohmann::json& view : scores["per_view"]) ExpectBudgetAddsUp(view);
 
+  // The textured mesh at the same held-out cameras: its renders and coverage masks written, its
+  // whole frames (missed pixels black) below the pixels it covers, and against its own masks
+  // (--mesh-common-with the same workspace) the common pixels are its covered ones.
+  const nlohmann::json mesh = ReadJson(workspace.Root() / "evaluation.json")["mesh_held_out"];
+  std::printf("[ measure ] textured mesh at the held-out cameras: %.2f dB on %.1f%% covered, %.2f dB whole frames\n",
+              mesh["covered_psnr_mean"].get<double>(), 100 * mesh["coverage_mean"].get<double>(),
+              mesh["psnr_mean"].get<double>());
+  ASSERT_EQ(mesh["per_view"].size(), 4u) << mesh.dump();
+  EXPECT_GT(mesh["covered_psnr_mean"].get<double>(), 20) << mesh.dump();
+  EXPECT_GT(mesh["coverage_mean"].get<double>(), 0.3) << mesh.dump();
+  EXPECT_LT(mesh["psnr_mean"].get<double>(), mesh["covered_psnr_mean"].get<double>()) << mesh.dump();
+  for (const std::string name : {"novel_0000", "novel_0003"}) {
+    EXPECT_TRUE(fs::exists(workspace.Root() / "evaluation" / "mesh_held_out" / (name + ".png"))) << name;
+    EXPECT_TRUE(fs::exists(workspace.Root() / "evaluation" / "mesh_held_out" / (name + ".covered.png"))) << name;
+  }
+  const CliResult common = RunParallax("evaluate " + Quote(held_out.string()) + " --mesh-common-with " +
+                                       Quote(held_out.string()) + " --json " + Quote((dir.Path() / "common.json").string()));
+  ASSERT_EQ(common.exit_code, 0) << common.output;
+  EXPECT_NE(common.output.find("both meshes cover"), std::string::npos) << common.output;
+  const nlohmann::json same = ReadJson(dir.Path() / "common.json")["mesh_held_out"];
+  EXPECT_NEAR(same["common_psnr_mean"].get<double>(), mesh["covered_psnr_mean"].get<double>(), 1e-9);
+  EXPECT_NEAR(same["common_share_mean"].get<double>(), mesh["coverage_mean"].get<double>(), 1e-9);
 }
 
 // The scene's cameras, its 12 training photos' and its 4 novel ones', in one model.

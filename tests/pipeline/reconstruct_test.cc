@@ -234,8 +234,10 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   const CloudAccuracy vertices = MeasureCloud(mesh.vertices, truth, scene.Training().depth, {});
   EXPECT_LT(vertices.median_relative_distance, 0.005);
   EXPECT_GT(vertices.within_1pct, 0.8);
-  const TexturedMeshScore texture =
-      ScoreTexturedMesh(mesh, model, ReadWorkspaceColorGains(workspace.Path()), workspace.Path() / "images", {});
+  std::vector<std::string> image_names;
+  const std::vector<NamedCamera> cameras = CamerasOfModel(model, &image_names);
+  const TexturedMeshScore texture = ScoreTexturedMesh(mesh, cameras, image_names, ReadWorkspaceColorGains(workspace.Path()),
+                                                      workspace.Path() / "images", {});
   std::printf("[ measure ] textured mesh: PSNR %.2f dB, coverage %.4f\n", texture.psnr_mean, texture.coverage_mean);
   EXPECT_EQ(texture.views, 12);
   EXPECT_GE(texture.psnr_mean, 25);
