@@ -1,8 +1,9 @@
 #pragma once
 // Texturing a mesh from the photos: every triangle gets its own cell in one atlas, colored
-// from the photo that sees it best (most head-on and most pixels per unit area) without
-// occlusion (Embree visibility). Photos nearly as good are blended in with a steeply falling
-// weight, so the seam between triangles that chose different photos fades instead of jumping.
+// from the photos that see it best (most head-on and most pixels per unit area) without
+// occlusion (Embree visibility), each weighed by the triangle's area in it: the seam between
+// triangles that chose different photos fades instead of jumping, and a viewpoint between the
+// photos sees their mean rather than one photo's reflections and misregistration.
 #include <functional>
 #include <vector>
 
@@ -32,9 +33,11 @@ struct TextureOptions {
   int min_texels_per_edge = 2;
   int max_texels_per_edge = 16;
   int max_atlas_size = 8192;
-  // Photos blended per triangle, and the exponent of their weight (score / best score).
+  // Photos blended per triangle, and the exponent of their weight (score / best score). A
+  // higher exponent draws each triangle from its best photo alone: sharper from that photo's
+  // camera, worse from anywhere else (docs/mesh.md).
   int max_views_per_triangle = 4;
-  double blend_exponent = 8;
+  double blend_exponent = 1;
   // A photo sees a triangle when the angle between its ray and the normal is below this. Near
   // 90: ground seen from head height 15 m away lies 84 degrees off, and a grazing photo beats
   // none (the blend weighs it by its small area on screen where a better photo sees the triangle).
