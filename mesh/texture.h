@@ -1,7 +1,7 @@
 #pragma once
 // Texturing a mesh from the photos: every triangle gets its own cell in one atlas, colored
 // from the photos that see it best (most head-on and most pixels per unit area) without
-// occlusion (Embree visibility), each weighed by the triangle's area in it: the seam between
+// occlusion (Embree visibility), up to 8, each weighed by the triangle's area in it: the seam between
 // triangles that chose different photos fades instead of jumping, and a viewpoint between the
 // photos sees their mean rather than one photo's reflections and misregistration.
 #include <functional>
@@ -33,10 +33,10 @@ struct TextureOptions {
   int min_texels_per_edge = 2;
   int max_texels_per_edge = 16;
   int max_atlas_size = 8192;
-  // Photos blended per triangle, and the exponent of their weight (score / best score). A
-  // higher exponent draws each triangle from its best photo alone: sharper from that photo's
-  // camera, worse from anywhere else (docs/mesh.md).
-  int max_views_per_triangle = 4;
+  // Photos blended per triangle (at most 8), and the exponent of their weight (score / best
+  // score). Fewer photos or a higher exponent draw each triangle from its best photo alone:
+  // sharper from that photo's camera, worse from anywhere else (docs/mesh.md).
+  int max_views_per_triangle = 8;
   double blend_exponent = 1;
   // A photo sees a triangle when the angle between its ray and the normal is below this. Near
   // 90: ground seen from head height 15 m away lies 84 degrees off, and a grazing photo beats
