@@ -53,11 +53,7 @@ std::vector<uint8_t> ReadCoverage(const fs::path& path, int width, int height) {
 
 Image CoverageImage(const std::vector<uint8_t>& covered, int width, int height) {
   Image mask(width, height, 1);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      mask.At(x, y, 0) = covered[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)];
-    }
-  }
+  for (size_t i = 0; i < covered.size(); ++i) mask.Pixels()[i] = covered[i];
   return mask;
 }
 
@@ -77,15 +73,6 @@ void ToPhotoExposure(const RgbGain& gain, Image& render) {
 }
 
 }  // namespace
-
-std::vector<NamedCamera> CamerasOfModel(const SparseModel& model, std::vector<std::string>* image_names) {
-  std::vector<NamedCamera> cameras;
-  for (const SparseImage& image : model.Images()) {
-    cameras.push_back({fs::path(image.name).stem().string(), {model.CameraById(image.camera_id), image.cam_from_world}});
-    image_names->push_back(image.name);
-  }
-  return cameras;
-}
 
 TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const std::vector<NamedCamera>& cameras,
                                     const std::vector<std::string>& image_names, const ColorGains& gains,

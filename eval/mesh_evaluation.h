@@ -37,9 +37,9 @@ struct TexturedMeshScore {
 };
 
 // Renders `mesh` at every camera (distortion-free; `image_names[i]` is camera i's photo in
-// `images_dir`) and compares with the photos. An atlas made at the photos' common exposure
-// (core/color_gains.h) is compared at each photo's own: its render divided by the photo's gain
-// in `gains` (1 for a photo without one). With a non-empty `render_dir`, writes each render
+// `images_dir`; a model's from CamerasOfModel) and compares with the photos. An atlas made at
+// the photos' common exposure (core/color_gains.h) is compared at each photo's own: its render
+// divided by the photo's gain in `gains` (1 for a photo without one). With a non-empty `render_dir`, writes each render
 // there as <name>.png (uncovered pixels black) and its coverage as <name>.covered.png (white
 // where covered). With a non-empty `common_dir` (another run's render_dir at the same cameras),
 // also scores the pixels both runs cover. Throws BadInputError naming a photo that is missing
@@ -49,9 +49,6 @@ TexturedMeshScore ScoreTexturedMesh(const TriangleMesh& mesh, const std::vector<
                                     const std::filesystem::path& images_dir,
                                     const std::filesystem::path& render_dir,
                                     const std::filesystem::path& common_dir = {});
-
-// Every image of `model` as ScoreTexturedMesh's cameras (named by stem) and photo names.
-std::vector<NamedCamera> CamerasOfModel(const SparseModel& model, std::vector<std::string>* image_names);
 
 // The textured mesh seen from a camera: sRGB color where covered, `covered` set there.
 // `raycaster` holds `mesh`'s triangles (built once, shared by all views).

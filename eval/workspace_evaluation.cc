@@ -206,13 +206,8 @@ WorkspaceEvaluation EvaluateHeldOut(const Workspace& workspace, const EvaluateOp
                         "reconstruct without --no-depth");
   }
   if (options.gt_sources) throw BadInputError("--gt-sources needs a scene folder with ground truth (--gt)");
-  const SparseModel model = ReadSparseModel(held_out.Sparse());
-  std::vector<NamedCamera> targets;
   std::vector<std::string> names;
-  for (const SparseImage& image : model.Images()) {
-    targets.push_back({fs::path(image.name).stem().string(), {model.CameraById(image.camera_id), image.cam_from_world}});
-    names.push_back(image.name);
-  }
+  const std::vector<NamedCamera> targets = CamerasOfModel(ReadSparseModel(held_out.Sparse()), &names);
   WorkspaceEvaluation evaluation;
   evaluation.held_out = true;
   NovelViewsEvaluation& novel = evaluation.novel.emplace();

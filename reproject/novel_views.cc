@@ -187,14 +187,18 @@ void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
 
 }  // namespace
 
-std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
-  const SparseModel model = ReadSparseModel(model_dir);
+std::vector<NamedCamera> CamerasOfModel(const SparseModel& model, std::vector<std::string>* image_names) {
   std::vector<NamedCamera> cameras;
   for (const SparseImage& image : model.Images()) {
-    cameras.push_back({fs::path(image.name).stem().string(),
-                       {model.CameraById(image.camera_id), image.cam_from_world}});
-    CheckRenderable(model_dir, cameras.back());
+    cameras.push_back({fs::path(image.name).stem().string(), {model.CameraById(image.camera_id), image.cam_from_world}});
+    if (image_names != nullptr) image_names->push_back(image.name);
   }
+  return cameras;
+}
+
+std::vector<NamedCamera> CamerasFromModel(const fs::path& model_dir) {
+  const std::vector<NamedCamera> cameras = CamerasOfModel(ReadSparseModel(model_dir));
+  for (const NamedCamera& camera : cameras) CheckRenderable(model_dir, camera);
   if (cameras.empty()) throw BadInputError(model_dir.string() + ": the model has no images");
   return cameras;
 }

@@ -9,6 +9,7 @@
 
 #include "core/color_gains.h"
 #include "core/scene_folder.h"
+#include "core/sparse_model.h"
 #include "reproject/render.h"
 #include "reproject/source_selection.h"
 #include "reproject/view.h"
@@ -24,6 +25,10 @@ struct NamedCamera {
   std::string name;  // Output file stem.
   PosedCamera camera;
 };
+
+// Every image of `model`, named by the image's stem, in the model's order; with `image_names`,
+// each image's file name there too.
+std::vector<NamedCamera> CamerasOfModel(const SparseModel& model, std::vector<std::string>* image_names = nullptr);
 
 // Every image of a COLMAP model (text or binary), named by the image's stem.
 std::vector<NamedCamera> CamerasFromModel(const std::filesystem::path& model_dir);
