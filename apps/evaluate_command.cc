@@ -179,6 +179,11 @@ void RegisterEvaluateCommand(CLI::App& app) {
                       "another workspace evaluated at the same held-out photos (a baseline's): also score "
                       "the textured mesh on the pixels both meshes cover")
       ->check(CLI::ExistingDirectory);
+  command->add_option("--mesh", arguments->options.mesh,
+                      "score this textured mesh instead of the workspace's: an OBJ, or a PLY with per-face "
+                      "texcoord and one texture (OpenMVS's TextureMesh --export-type ply); its texture "
+                      "is taken as the photos' own colors (no color gains). bench/openmvs-mesh uses it")
+      ->check(CLI::ExistingFile);
   AddNovelViewOptions(*command, arguments->options.novel);
   command->callback([arguments] {
     arguments->options.align = !arguments->no_align;

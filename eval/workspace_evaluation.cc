@@ -36,10 +36,26 @@ std::optional<std::map<std::string, double>> ReconstructTimings(const Workspace&
   }
 }
 
+// The textured mesh to score: another tool's (options.mesh) or the workspace's.
+fs::path ScoredMeshPath(const Workspace& workspace, const EvaluateOptions& options) {
+  return options.mesh.empty() ? workspace.Mesh() : options.mesh;
+}
+
+TriangleMesh ReadScoredMesh(const Workspace& workspace, const EvaluateOptions& options) {
+  const fs::path path = ScoredMeshPath(workspace, options);
+  return path.extension() == ".ply" ? ReadPly(path) : ReadTexturedMesh(path);
+}
+
+// The color gains the scored mesh's texture is corrected by: none for another tool's mesh.
+ColorGains ScoredMeshGains(const Workspace& workspace, const EvaluateOptions& options) {
+  return options.mesh.empty() ? ReadWorkspaceColorGains(workspace.Root()) : ColorGains();
+}
+
 MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estimate,
                             const SparseModel& truth, const SceneFolder& scene,
-                            const Similarity3d& truth_from_estimate, bool truth_depth) {
-  const TriangleMesh mesh = ReadTexturedMesh(workspace.Mesh());
+                            const Similarity3d& truth_from_estimate, bool truth_depth,
+                            const EvaluateOptions& options) {
+  const TriangleMesh mesh = ReadScoredMesh(workspace, options);
   MeshEvaluation result;
   result.triangles = mesh.triangles.size();
   result.vertices = mesh.vertices.size();
@@ -49,7 +65,7 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
   result.render_dir = EvaluationLayout(workspace.Root()).MeshRenders();
   std::vector<std::string> names;
   const std::vector<NamedCamera> cameras = CamerasOfModel(estimate, &names);
-  result.texture = ScoreTexturedMesh(mesh, cameras, names, ReadWorkspaceColorGains(workspace.Root()), workspace.Images(),
+  result.texture = ScoreTexturedMesh(mesh, cameras, names, ScoredMeshGains(workspace, options), workspace.Images(),
                                      result.render_dir);
   return result;
 }
@@ -59,12 +75,12 @@ MeshEvaluation EvaluateMesh(const Workspace& workspace, const SparseModel& estim
 void ScoreMeshAtNovelCameras(const Workspace& workspace, const std::vector<NamedCamera>& targets,
                              const std::vector<std::string>& names, const fs::path& images,
                              const EvaluateOptions& options, WorkspaceEvaluation& evaluation) {
-  if (!fs::exists(workspace.Mesh())) return;
+  if (!fs::exists(ScoredMeshPath(workspace, options))) return;
   evaluation.mesh_held_out_dir = EvaluationLayout(workspace.Root()).MeshHeldOutRenders();
   const fs::path common =
       options.mesh_common_with.empty() ? fs::path() : EvaluationLayout(options.mesh_common_with).MeshHeldOutRenders();
-  evaluation.mesh_held_out = ScoreTexturedMesh(ReadTexturedMesh(workspace.Mesh()), targets, names,
-                                               ReadWorkspaceColorGains(workspace.Root()), images,
+  evaluation.mesh_held_out = ScoreTexturedMesh(ReadScoredMesh(workspace, options), targets, names,
+                                               ScoredMeshGains(workspace, options), images,
                                                evaluation.mesh_held_out_dir, common);
 }
 
@@ -170,8 +186,8 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
     evaluation.fused = MeasureCloud(ReadPly(workspace.Fused()).vertices, truth,
                                     scene.Training().depth, truth_from_estimate);
   }
-  if (fs::exists(workspace.Mesh()) && !options.novel_only) {
-    evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate, truth_depth);
+  if (fs::exists(ScoredMeshPath(workspace, options)) && !options.novel_only) {
+    evaluation.mesh = EvaluateMesh(workspace, estimate, truth, scene, truth_from_estimate, truth_depth, options);
   }
   if (fs::is_directory(scene.Novel().sparse) && (options.gt_sources || has_depth)) {
     std::vector<NamedCamera> targets;

@@ -41,6 +41,10 @@ struct EvaluateOptions {
   // Another workspace evaluated at the same held-out cameras: the textured mesh is also scored
   // on the pixels both meshes cover (its evaluation/mesh_held_out/<name>.covered.png).
   std::filesystem::path mesh_common_with;
+  // Score this textured mesh (OBJ, or PLY with texture coordinates, such as OpenMVS's
+  // TextureMesh writes) instead of the workspace's; its texture holds the photos' own colors,
+  // so no color gains are applied. Empty: the workspace's mesh/mesh.obj.
+  std::filesystem::path mesh;
 };
 
 struct MeshEvaluation {

@@ -1,5 +1,6 @@
 #include "geometry/ply.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -10,6 +11,7 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "core/image.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -34,6 +36,7 @@ struct Element {
 
 struct Header {
   std::vector<Element> elements;
+  std::vector<std::string> texture_files;  // "comment TextureFile NAME" lines (OpenMVS).
   size_t body = 0;  // Offset of the first data byte.
 };
 
@@ -51,7 +54,11 @@ Header ParseHeader(const std::string& bytes, const fs::path& path) {
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
-    if (keyword == "format") {
+    if (keyword == "comment") {
+      std::string tag, name;
+      words >> tag >> name;
+      if (tag == "TextureFile" && !name.empty()) header.texture_files.push_back(name);
+    } else if (keyword == "format") {
       std::string format;
       words >> format;
       little_endian = format == "binary_little_endian";
@@ -153,39 +160,128 @@ void ReadVertices(const std::string& bytes, const Element& element, size_t& offs
   offset += element.count * element.stride;
 }
 
+// One face property: a list (count, then values) or a scalar.
+struct FaceProperty {
+  bool list = false;
+  std::string count_type, value_type, name;
+};
+
+std::vector<FaceProperty> FaceProperties(const Element& element) {
+  std::vector<FaceProperty> properties;
+  for (const std::string& spec : element.properties) {
+    std::istringstream words(spec);
+    FaceProperty property;
+    std::string first;
+    words >> first;
+    property.list = first == "list";
+    if (property.list) {
+      words >> property.count_type >> property.value_type >> property.name;
+    } else {
+      property.value_type = first;
+      words >> property.name;
+    }
+    properties.push_back(property);
+  }
+  return properties;
+}
+
+// Faces: a vertex_indices list of 3, optionally a texcoord list of 6 floats (u, v per corner, as
+// OpenMVS's TextureMesh writes them) and a texnumber (which atlas; only 0 is supported); other
+// properties are skipped.
 void ReadFaces(const std::string& bytes, const Element& element, size_t& offset,
                const fs::path& path, TriangleMesh& mesh) {
-  std::istringstream list(element.properties.size() == 1 ? element.properties[0] : "");
-  std::string keyword, count_type, index_type, name;
-  list >> keyword >> count_type >> index_type >> name;
-  if (keyword != "list" || (name != "vertex_indices" && name != "vertex_index")) {
-    throw BadInputError(path.string() + ": faces must hold one vertex_indices list");
+  const std::vector<FaceProperty> properties = FaceProperties(element);
+  const auto has = [&](const std::string& name) {
+    return std::any_of(properties.begin(), properties.end(),
+                       [&](const FaceProperty& property) { return property.list && property.name == name; });
+  };
+  if (!has("vertex_indices") && !has("vertex_index")) {
+    throw BadInputError(path.string() + ": faces must hold a vertex_indices list");
   }
-  const size_t count_size = TypeSize(count_type), index_size = TypeSize(index_type);
   const std::string truncated = path.string() + ": face data is truncated";
+  const auto take = [&](size_t size) {
+    if (bytes.size() - offset < size) throw BadInputError(truncated);
+    const char* data = bytes.data() + offset;
+    offset += size;
+    return data;
+  };
   mesh.triangles.reserve(element.count);
+  if (has("texcoord")) mesh.corner_uvs.reserve(3 * element.count);
   for (size_t f = 0; f < element.count; ++f) {
-    if (bytes.size() - offset < count_size) throw BadInputError(truncated);
-    const int64_t corners = LoadInteger(count_type, bytes.data() + offset);
-    offset += count_size;
-    if (corners != 3) {
-      throw BadInputError(path.string() + ": face " + std::to_string(f) + " has " +
-                          std::to_string(corners) + " corners; only triangles are supported");
-    }
-    if ((bytes.size() - offset) / index_size < 3) throw BadInputError(truncated);
-    Eigen::Vector3i triangle;
-    for (int c = 0; c < 3; ++c) {
-      const int64_t index = LoadInteger(index_type, bytes.data() + offset);
-      offset += index_size;
-      if (index < 0 || index >= static_cast<int64_t>(mesh.vertices.size())) {
-        throw BadInputError(path.string() + ": face " + std::to_string(f) +
-                            " refers to vertex " + std::to_string(index) + " of " +
-                            std::to_string(mesh.vertices.size()));
+    const std::string face = path.string() + ": face " + std::to_string(f);
+    for (const FaceProperty& property : properties) {
+      const size_t value_size = TypeSize(property.value_type);
+      if (!property.list) {
+        const char* data = take(value_size);
+        if (property.name == "texnumber" && LoadInteger(property.value_type, data) != 0) {
+          throw BadInputError(face + " uses texture " + std::to_string(LoadInteger(property.value_type, data)) +
+                              "; only meshes with one texture are supported");
+        }
+        continue;
       }
-      triangle[c] = static_cast<int>(index);
+      const int64_t count = LoadInteger(property.count_type, take(TypeSize(property.count_type)));
+      if (count < 0) throw BadInputError(face + ": negative list length");
+      if ((bytes.size() - offset) / value_size < static_cast<size_t>(count)) throw BadInputError(truncated);
+      if (property.name == "vertex_indices" || property.name == "vertex_index") {
+        if (count != 3) {
+          throw BadInputError(face + " has " + std::to_string(count) + " corners; only triangles are supported");
+        }
+        Eigen::Vector3i triangle;
+        for (int c = 0; c < 3; ++c) {
+          const int64_t index = LoadInteger(property.value_type, take(value_size));
+          if (index < 0 || index >= static_cast<int64_t>(mesh.vertices.size())) {
+            throw BadInputError(face + " refers to vertex " + std::to_string(index) + " of " +
+                                std::to_string(mesh.vertices.size()));
+          }
+          triangle[c] = static_cast<int>(index);
+        }
+        mesh.triangles.push_back(triangle);
+      } else if (property.name == "texcoord") {
+        if (count != 6 || property.value_type != "float") {
+          throw BadInputError(face + ": texcoord must be 6 floats, one u, v per corner");
+        }
+        for (int c = 0; c < 3; ++c) {
+          Eigen::Vector2f uv;
+          std::memcpy(uv.data(), take(8), 8);
+          if (!uv.allFinite()) throw BadInputError(face + ": texcoord is NaN or Inf");
+          mesh.corner_uvs.push_back(uv);
+        }
+      } else {
+        take(value_size * static_cast<size_t>(count));
+      }
     }
-    mesh.triangles.push_back(triangle);
   }
+}
+
+// The one texture a textured PLY names, beside the file.
+Image ReadAtlas(const fs::path& path, const std::vector<std::string>& texture_files) {
+  if (texture_files.size() != 1) {
+    throw BadInputError(path.string() + ": faces have texcoord, but the file names " +
+                        std::to_string(texture_files.size()) +
+                        " textures (comment TextureFile); only one is supported");
+  }
+  Image atlas = ReadImage(path.parent_path() / texture_files.front());
+  if (atlas.Channels() < 3) throw BadInputError(path.string() + ": its texture must be an RGB image");
+  return atlas;
+}
+
+// Leaves out the triangles with a NaN or Inf corner (and their texture coordinates).
+void DropNonFiniteTriangles(TriangleMesh& mesh) {
+  const bool uvs = mesh.corner_uvs.size() == 3 * mesh.triangles.size();
+  size_t kept = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& triangle = mesh.triangles[t];
+    bool finite = true;
+    for (int c = 0; c < 3; ++c) finite = finite && mesh.vertices[static_cast<size_t>(triangle[c])].allFinite();
+    if (!finite) continue;
+    mesh.triangles[kept] = triangle;
+    if (uvs) {
+      for (size_t c = 0; c < 3; ++c) mesh.corner_uvs[3 * kept + c] = mesh.corner_uvs[3 * t + c];
+    }
+    ++kept;
+  }
+  mesh.triangles.resize(kept);
+  if (uvs) mesh.corner_uvs.resize(3 * kept);
 }
 
 }  // namespace
@@ -209,14 +305,8 @@ TriangleMesh ReadPly(const fs::path& path, NonFiniteVertices non_finite) {
     }
   }
   if (!has_vertices) throw BadInputError(path.string() + ": no vertex element");
-  if (non_finite == NonFiniteVertices::kDropTheirTriangles) {
-    std::erase_if(mesh.triangles, [&](const Eigen::Vector3i& triangle) {
-      for (int c = 0; c < 3; ++c) {
-        if (!mesh.vertices[static_cast<size_t>(triangle[c])].allFinite()) return true;
-      }
-      return false;
-    });
-  }
+  if (!mesh.corner_uvs.empty()) mesh.atlas = ReadAtlas(path, header.texture_files);
+  if (non_finite == NonFiniteVertices::kDropTheirTriangles) DropNonFiniteTriangles(mesh);
   return mesh;
 }
 

@@ -1,9 +1,12 @@
 #pragma once
 // Reading binary little-endian PLY files: our fused clouds, COLMAP's fused.ply and the meshes
-// `colmap poisson_mesher` writes. Only what parallax needs: vertex positions (float x, y, z as
-// the first three vertex properties), normals (float nx, ny, nz) and colors (uchar red, green,
-// blue) when present, any other property skipped, and triangle faces (a `vertex_indices`
-// list). Every count and index is checked against the file before use.
+// `colmap poisson_mesher` writes, and the textured meshes of OpenMVS's TextureMesh. Only what
+// parallax needs: vertex positions (float x, y, z as the first three vertex properties),
+// normals (float nx, ny, nz) and colors (uchar red, green, blue) when present, any other
+// property skipped, and triangle faces (a `vertex_indices` list) with, when present, their
+// corners' texture coordinates (a `texcoord` list of 6 floats, OBJ convention) and the one
+// texture a `comment TextureFile NAME` line names beside the file. Every count and index is
+// checked against the file before use.
 #include <filesystem>
 #include <vector>
 
