@@ -8,6 +8,7 @@
 
 #include "core/hash.h"
 #include "core/check.h"
+#include "geometry/mesh_pieces.h"
 
 namespace parallax {
 namespace {
@@ -66,24 +67,15 @@ TriangleMesh Trim(const TriangleMesh& mesh, const PointGrid& grid, float radius)
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     near[v] = mesh.vertices[v].allFinite() && grid.AnyWithin(mesh.vertices[v], radius);
   }
-  TriangleMesh trimmed;
-  std::vector<int> new_index(mesh.vertices.size(), -1);
-  for (const Eigen::Vector3i& triangle : mesh.triangles) {
-    if (!near[static_cast<size_t>(triangle[0])] || !near[static_cast<size_t>(triangle[1])] ||
-        !near[static_cast<size_t>(triangle[2])]) {
-      continue;
-    }
-    Eigen::Vector3i renumbered;
-    for (int c = 0; c < 3; ++c) {
-      int& index = new_index[static_cast<size_t>(triangle[c])];
-      if (index < 0) {
-        index = static_cast<int>(trimmed.vertices.size());
-        trimmed.vertices.push_back(mesh.vertices[static_cast<size_t>(triangle[c])]);
-      }
-      renumbered[c] = index;
-    }
-    trimmed.triangles.push_back(renumbered);
+  std::vector<uint8_t> keep(mesh.triangles.size());
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Eigen::Vector3i& triangle = mesh.triangles[t];
+    keep[t] = near[static_cast<size_t>(triangle[0])] && near[static_cast<size_t>(triangle[1])] &&
+              near[static_cast<size_t>(triangle[2])];
   }
+  TriangleMesh trimmed = KeepTriangles(mesh, keep);
+  trimmed.normals.clear();  // Only positions go on to the texture.
+  trimmed.colors.clear();
   return trimmed;
 }
 
@@ -95,6 +87,7 @@ void MeshOptions::Check() const {
   RequireOption(poisson_trim >= 0, "MeshOptions.poisson_trim", poisson_trim, ">= 0");
   RequireOption(display_max_triangles >= 1, "MeshOptions.display_max_triangles",
                 static_cast<double>(display_max_triangles), ">= 1");
+  support.Check();
   texture.Check();
 }
 
@@ -119,7 +112,10 @@ void to_json(nlohmann::json& json, const MeshSummary& mesh) {
           {"texels_per_edge", mesh.texels_per_edge},
           {"untextured_triangles", mesh.untextured_triangles},
           {"atlas_size", {mesh.atlas_width, mesh.atlas_height}},
-          {"display_triangles", mesh.display_triangles}};
+          {"display_triangles", mesh.display_triangles},
+          {"pieces", mesh.pieces},
+          {"dropped_pieces", mesh.dropped_pieces},
+          {"dropped_triangles", mesh.dropped_triangles}};
 }
 
 void from_json(const nlohmann::json& json, MeshSummary& mesh) {
@@ -131,6 +127,9 @@ void from_json(const nlohmann::json& json, MeshSummary& mesh) {
   json.at("atlas_size").at(0).get_to(mesh.atlas_width);
   json.at("atlas_size").at(1).get_to(mesh.atlas_height);
   json.at("display_triangles").get_to(mesh.display_triangles);
+  json.at("pieces").get_to(mesh.pieces);
+  json.at("dropped_pieces").get_to(mesh.dropped_pieces);
+  json.at("dropped_triangles").get_to(mesh.dropped_triangles);
 }
 
 }  // namespace parallax

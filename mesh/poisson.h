@@ -1,9 +1,10 @@
 #pragma once
 // The mesh stage's options and summary, and its own step between Poisson and texture: fused
 // cloud -> screened Poisson surface (watertight) -> trimmed to where the cloud has data
-// (TrimToData) -> textured from the photos (mesh/texture.h), and a simplified copy for
-// display. The stage over a workspace, which runs `colmap poisson_mesher` and writes
-// <ws>/mesh/ and <ws>/mesh_display/, is pipeline/mesh_workspace.h.
+// (TrimToData) -> without floaters (mesh/support.h) -> textured from the photos
+// (mesh/texture.h), and a simplified copy for display. The stage over a workspace, which runs
+// `colmap poisson_mesher` and writes <ws>/mesh/ and <ws>/mesh_display/, is
+// pipeline/mesh_workspace.h.
 #include <cstddef>
 #include <vector>
 
@@ -12,6 +13,7 @@
 
 #include "core/quality.h"
 #include "geometry/triangle_mesh.h"
+#include "mesh/support.h"
 #include "mesh/texture.h"
 
 namespace parallax {
@@ -31,6 +33,7 @@ struct MeshOptions {
   // at most this many (about one per 28 pixels of a 1280x720 view), textured on its own, which
   // the viewer draws when the full mesh would have more triangles than the pixels need.
   size_t display_max_triangles = 32768;
+  SupportOptions support;  // Which pieces of the trimmed surface are floaters.
   TextureOptions texture;
   void Check() const;
 };
@@ -40,12 +43,15 @@ MeshOptions MeshOptionsFor(Quality quality);
 
 struct MeshSummary {
   size_t poisson_triangles = 0;
-  size_t triangles = 0;  // After trimming.
+  size_t triangles = 0;  // After trimming and dropping floaters.
   size_t vertices = 0;
   int texels_per_edge = 0;
   size_t untextured_triangles = 0;
   int atlas_width = 0, atlas_height = 0;
   size_t display_triangles = 0;  // 0: the mesh is small enough to display as it is.
+  size_t pieces = 0;             // Connected pieces of the trimmed surface ...
+  size_t dropped_pieces = 0;     // ... the floaters among them ...
+  size_t dropped_triangles = 0;  // ... and their triangles.
 };
 
 // <ws>/mesh/summary.json and report.json's "mesh" section.

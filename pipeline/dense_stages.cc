@@ -21,7 +21,7 @@ namespace {
 // Bump when a stage's results change for the same options, so caches recompute.
 constexpr const char* kMvsVersion = "patch-match-6";
 constexpr const char* kFusionVersion = "fusion-6";
-constexpr const char* kMeshVersion = "mesh-8";
+constexpr const char* kMeshVersion = "mesh-9";
 constexpr const char* kColorGainsVersion = "color-gains-1";
 
 // The working scale of every view, when one is below 1: what the results depend on, rather

@@ -11,6 +11,7 @@
 #include "geometry/obj.h"
 #include "geometry/ply.h"
 #include "geometry/simplify.h"
+#include "mesh/support.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -31,6 +32,19 @@ std::vector<TextureView> LoadTextureViews(const Workspace& workspace) {
       return color;
     };
     views.push_back(std::move(view));
+  }
+  return views;
+}
+
+// The cameras of the photos with a depth map, each map read when needed. Photos held out of
+// the depth stage have none.
+std::vector<SupportView> LoadSupportViews(const Workspace& workspace) {
+  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+  std::vector<SupportView> views;
+  for (const SparseImage& image : model.Images()) {
+    const fs::path depth = workspace.Depth(image.name);
+    if (!fs::exists(depth)) continue;
+    views.push_back({model.CameraById(image.camera_id), image.cam_from_world, [depth] { return ReadDepthExr(depth); }});
   }
   return views;
 }
@@ -72,14 +86,21 @@ MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, cons
   options.Check();
   MeshSummary summary;
   const TriangleMesh trimmed = TrimmedPoissonSurface(workspace, colmap, options, progress, summary.poisson_triangles);
-  summary.triangles = trimmed.triangles.size();
-  summary.vertices = trimmed.vertices.size();
+  progress.Update("floaters", 0, 1);
+  SupportSummary support;
+  const TriangleMesh surface = DropUnsupportedPieces(trimmed, LoadSupportViews(workspace), options.support, support);
+  summary.pieces = support.pieces;
+  summary.dropped_pieces = support.dropped_pieces;
+  summary.dropped_triangles = support.dropped_triangles;
+  progress.Update("floaters", 1, 1);
+  summary.triangles = surface.triangles.size();
+  summary.vertices = surface.vertices.size();
 
   progress.Update("texture", 0, 1);
   const std::vector<TextureView> views = LoadTextureViews(workspace);
   {  // The full atlas is freed before the display copy's is made.
     TextureSummary texture;
-    const TriangleMesh textured = TextureMesh(trimmed.vertices, trimmed.triangles, views, options.texture, texture);
+    const TriangleMesh textured = TextureMesh(surface.vertices, surface.triangles, views, options.texture, texture);
     WriteTexturedMesh(workspace.MeshDir(), textured);
     summary.texels_per_edge = texture.texels_per_edge;
     summary.untextured_triangles = texture.untextured_triangles;
@@ -89,9 +110,9 @@ MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, cons
   progress.Update("texture", 1, 1);
 
   const fs::path display = workspace.DisplayMeshDir();
-  if (trimmed.triangles.size() > options.display_max_triangles) {
+  if (surface.triangles.size() > options.display_max_triangles) {
     progress.Update("display mesh", 0, 1);
-    const TriangleMesh simplified = SimplifyMesh(trimmed, options.display_max_triangles);
+    const TriangleMesh simplified = SimplifyMesh(surface, options.display_max_triangles);
     TextureSummary display_texture;
     WriteTexturedMesh(display, TextureMesh(simplified.vertices, simplified.triangles, views, options.texture,
                                            display_texture));
