@@ -17,12 +17,20 @@ namespace parallax {
 namespace fs = std::filesystem;
 namespace {
 
+// PLY's two spellings of each type (OpenMVS writes float32, uint8, ...), as the first one; an
+// unknown type stays as it is.
+std::string CanonicalType(const std::string& type) {
+  static const std::map<std::string, std::string> names = {
+      {"int8", "char"}, {"uint8", "uchar"}, {"int16", "short"}, {"uint16", "ushort"}, {"int32", "int"},
+      {"uint32", "uint"}, {"float32", "float"}, {"float64", "double"}};
+  const auto found = names.find(type);
+  return found == names.end() ? type : found->second;
+}
+
+// Bytes of a canonical type; 0 for an unknown one.
 size_t TypeSize(const std::string& type) {
-  static const std::map<std::string, size_t> sizes = {
-      {"char", 1},  {"uchar", 1}, {"int8", 1},   {"uint8", 1},   {"short", 2},
-      {"ushort", 2}, {"int16", 2}, {"uint16", 2}, {"int", 4},     {"uint", 4},
-      {"int32", 4}, {"uint32", 4}, {"float", 4}, {"float32", 4}, {"double", 8},
-      {"float64", 8}};
+  static const std::map<std::string, size_t> sizes = {{"char", 1}, {"uchar", 1}, {"short", 2}, {"ushort", 2},
+                                                      {"int", 4},  {"uint", 4},  {"float", 4}, {"double", 8}};
   const auto found = sizes.find(type);
   return found == sizes.end() ? 0 : found->second;
 }
@@ -75,6 +83,8 @@ Header ParseHeader(const std::string& bytes, const fs::path& path) {
       if (type == "list") {
         std::string count_type, index_type, name;
         words >> count_type >> index_type >> name;
+        count_type = CanonicalType(count_type);
+        index_type = CanonicalType(index_type);
         if (TypeSize(count_type) == 0 || TypeSize(index_type) == 0) {
           throw BadInputError(path.string() + ": unsupported list property '" + line + "'");
         }
@@ -82,6 +92,7 @@ Header ParseHeader(const std::string& bytes, const fs::path& path) {
       } else {
         std::string name;
         words >> name;
+        type = CanonicalType(type);
         if (TypeSize(type) == 0) {
           throw BadInputError(path.string() + ": unsupported property type '" + type + "'");
         }
@@ -105,12 +116,12 @@ int64_t Load(const char* data) {
 
 // Integer value of a list count or index stored as `type`.
 int64_t LoadInteger(const std::string& type, const char* data) {
-  if (type == "uchar" || type == "uint8") return Load<uint8_t>(data);
-  if (type == "char" || type == "int8") return Load<int8_t>(data);
-  if (type == "ushort" || type == "uint16") return Load<uint16_t>(data);
-  if (type == "short" || type == "int16") return Load<int16_t>(data);
-  if (type == "uint" || type == "uint32") return Load<uint32_t>(data);
-  if (type == "int" || type == "int32") return Load<int32_t>(data);
+  if (type == "uchar") return Load<uint8_t>(data);
+  if (type == "char") return Load<int8_t>(data);
+  if (type == "ushort") return Load<uint16_t>(data);
+  if (type == "short") return Load<int16_t>(data);
+  if (type == "uint") return Load<uint32_t>(data);
+  if (type == "int") return Load<int32_t>(data);
   return -1;  // Floating-point list types are not indices.
 }
 
