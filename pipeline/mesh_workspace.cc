@@ -18,8 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // The cameras, each photo read (and corrected by its color gain) only when the texture needs it.
-std::vector<TextureView> LoadTextureViews(const Workspace& workspace) {
-  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+std::vector<TextureView> LoadTextureViews(const Workspace& workspace, const SparseModel& model) {
   const ColorGains gains = ReadWorkspaceColorGains(workspace.Root());
   std::vector<TextureView> views;
   for (const SparseImage& image : model.Images()) {
@@ -38,13 +37,13 @@ std::vector<TextureView> LoadTextureViews(const Workspace& workspace) {
 
 // The cameras of the photos with a depth map, each map read when needed. Photos held out of
 // the depth stage have none.
-std::vector<SupportView> LoadSupportViews(const Workspace& workspace) {
-  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+std::vector<SupportView> LoadSupportViews(const Workspace& workspace, const SparseModel& model) {
   std::vector<SupportView> views;
   for (const SparseImage& image : model.Images()) {
     const fs::path depth = workspace.Depth(image.name);
     if (!fs::exists(depth)) continue;
-    views.push_back({model.CameraById(image.camera_id), image.cam_from_world, [depth] { return ReadDepthExr(depth); }});
+    views.push_back(
+        {model.CameraById(image.camera_id), image.cam_from_world, [depth] { return ReadDepthExr(depth); }});
   }
   return views;
 }
@@ -86,9 +85,11 @@ MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, cons
   options.Check();
   MeshSummary summary;
   const TriangleMesh trimmed = TrimmedPoissonSurface(workspace, colmap, options, progress, summary.poisson_triangles);
+  const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
   progress.Update("floaters", 0, 1);
   SupportSummary support;
-  const TriangleMesh surface = DropUnsupportedPieces(trimmed, LoadSupportViews(workspace), options.support, support);
+  const TriangleMesh surface =
+      DropUnsupportedPieces(trimmed, LoadSupportViews(workspace, model), options.support, support);
   summary.pieces = support.pieces;
   summary.dropped_pieces = support.dropped_pieces;
   summary.dropped_triangles = support.dropped_triangles;
@@ -97,7 +98,7 @@ MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, cons
   summary.vertices = surface.vertices.size();
 
   progress.Update("texture", 0, 1);
-  const std::vector<TextureView> views = LoadTextureViews(workspace);
+  const std::vector<TextureView> views = LoadTextureViews(workspace, model);
   {  // The full atlas is freed before the display copy's is made.
     TextureSummary texture;
     const TriangleMesh textured = TextureMesh(surface.vertices, surface.triangles, views, options.texture, texture);
