@@ -1,11 +1,13 @@
 #include "eval/register_held_out.h"
 
 #include <algorithm>
-#include <exception>
 #include <map>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/hash.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
@@ -13,6 +15,7 @@
 #include "colmap/database.h"
 #include "sfm/photo_conversion.h"
 #include "sfm/photo_set.h"
+#include "sfm/quality_settings.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -34,6 +37,27 @@ std::map<std::string, std::string> StagedNames(const std::vector<std::string>& n
   return staged;
 }
 
+// The SIFT settings the workspace's photos were extracted with (report.json), so that the
+// held-out photos' features are found at the same scale; a workspace whose report does not
+// record them (made before it did, or from known cameras by hand) used balanced's.
+QualitySettings WorkspaceFeatureSettings(const Workspace& ws) {
+  QualitySettings settings = SettingsFor(Quality::kBalanced);
+  if (!fs::exists(ws.Report())) return settings;
+  try {
+    const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(ws.Report()));
+    const nlohmann::json::json_pointer features("/reconstruct/features");
+    if (!report.contains(features)) return settings;
+    settings.max_image_size = report.at(features).at("max_image_size").get<int>();
+    settings.max_num_features = report.at(features).at("max_num_features").get<int>();
+  } catch (const nlohmann::json::exception& e) {
+    throw BadInputError(ws.Report().string() + ": cannot read the feature settings: " + e.what());
+  }
+  if (settings.max_image_size <= 0 || settings.max_num_features <= 0) {
+    throw BadInputError(ws.Report().string() + ": feature settings must be positive");
+  }
+  return settings;
+}
+
 // Links (or copies) each photo into <work_dir>/photos under its staged name; a photo colmap
 // cannot read as it is (16-bit, grey, turned, ...) is converted there as `reconstruct` does.
 void StagePhotos(const fs::path& images_dir, const std::map<std::string, std::string>& staged,
@@ -52,12 +76,13 @@ void StagePhotos(const fs::path& images_dir, const std::map<std::string, std::st
 }
 
 // Copies the database into `work_dir`, adds the photos' features (under their staged names)
-// and their matches with every registered image, and registers them into a copy of
-// `raw_model` at <work_dir>/model. Throws ToolError when colmap fails.
+// (extracted with `features`, as the database's were) and their matches with every registered
+// image, and registers them into a copy of `raw_model` at <work_dir>/model. Throws ToolError
+// when colmap fails.
 void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, const SparseModel& model,
-                        const fs::path& images_dir, const std::map<std::string, std::string>& staged,
-                        const std::string& list, const std::string& pairs, const fs::path& work_dir,
-                        Progress& progress) {
+                        const QualitySettings& features, const fs::path& images_dir,
+                        const std::map<std::string, std::string>& staged, const std::string& list,
+                        const std::string& pairs, const fs::path& work_dir, Progress& progress) {
   const fs::path registered = work_dir / "model";
   fs::remove_all(work_dir);
   fs::create_directories(registered);
@@ -73,8 +98,9 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
   std::vector<std::string> extract = {
       "--database_path", db.string(), "--image_path", photos_dir.string(),
       "--image_list_path", (work_dir / "image_list.txt").string(),
-      "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "2000",
-      "--SiftExtraction.max_num_features", "4096"};
+      "--SiftExtraction.use_gpu", "0",
+      "--SiftExtraction.max_image_size", std::to_string(features.max_image_size),
+      "--SiftExtraction.max_num_features", std::to_string(features.max_num_features)};
   // One shared camera (the usual capture, or one camera per photo with the same intrinsics, as
   // calibrated datasets list them): the held-out photos are taken with it. Registering them
   // with a camera of their own instead would estimate its focal length, and trade it against
@@ -118,12 +144,16 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
     return result;
   }
   const SparseModel model = ReadSparseModel(raw_model);
+  const QualitySettings features = WorkspaceFeatureSettings(ws);
   // Photos the database holds already (registered or not) would be taken for these.
   const std::map<std::string, DatabaseImage> in_database = ReadDatabaseImages(database);
   const std::map<std::string, std::string> staged = StagedNames(names, in_database);
   std::string pairs, list;
   Hasher key_hasher;
-  key_hasher.Add("held-out-4").Add(static_cast<uint64_t>(fs::file_size(database)));
+  key_hasher.Add("held-out-5")
+      .Add(static_cast<uint64_t>(fs::file_size(database)))
+      .Add(static_cast<uint64_t>(features.max_image_size))
+      .Add(static_cast<uint64_t>(features.max_num_features));
   std::vector<fs::path> model_files(fs::directory_iterator(raw_model), fs::directory_iterator{});
   std::sort(model_files.begin(), model_files.end());
   for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
@@ -140,9 +170,10 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
                      DetectSparseFormat(registered);
   if (!reuse) {
     try {
-      RegisterWithColmap(database, raw_model, model, images_dir, staged, list, pairs, work_dir, progress);
+      RegisterWithColmap(database, raw_model, model, features, images_dir, staged, list, pairs, work_dir,
+                         progress);
       WriteFileAtomically(key_file, key);
-    } catch (const std::exception& e) {
+    } catch (const ToolError& e) {  // Only colmap's failure is a result; the rest is an error.
       result.note = std::string("colmap could not register them: ") + e.what();
       return result;
     }
@@ -155,7 +186,9 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   }
   result.note = std::to_string(result.cam_from_world.size()) + " of " +
                 std::to_string(names.size()) +
-                " registered into the SfM model by colmap image_registrator" +
+                " registered into the SfM model by colmap image_registrator (SIFT at up to " +
+                std::to_string(features.max_image_size) + " px, " + std::to_string(features.max_num_features) +
+                " features, as the workspace's)" +
                 (reuse ? " (reused from " + work_dir.string() + ")" : " (" + work_dir.string() + ")");
   return result;
 }

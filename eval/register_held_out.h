@@ -16,19 +16,20 @@ struct HeldOutRegistration {
   std::string note;  // What was done (or reused), or why nothing was registered.
 };
 
-// Registers the photos `names` of `images_dir` into the SfM model of `workspace`
-// (<ws>/sfm/sparse and its database): SIFT features with the workspace's shared camera,
-// matched against every registered training photo, then `colmap image_registrator`, which
+// Registers the photos `names` of `images_dir` into the SfM model of `workspace` (<ws>/sfm/sparse
+// and its database): SIFT features with the workspace's shared camera, extracted at the scale and
+// count its photos were (report.json's reconstruct.features; balanced's where the report predates
+// them), matched against every registered training photo, then `colmap image_registrator`, which
 // adds the photos without moving the training cameras (the depth maps stay valid). The photos'
-// pixels give their poses only; nothing is rendered from them. Aligning ground-truth poses
-// with a similarity instead carries the reconstruction's local pose errors into the
-// novel cameras. Work and logs go to `work_dir`; a second
-// call with the same photos (names and bytes), the same model and database size reuses the
-// result. The photos are registered under prefixed names, so they may share names with
-// training photos. Returns an empty map and the reason when the workspace has no database
-// (e.g. made from known cameras) or COLMAP fails. The rendered
-// targets keep their own (ground-truth) intrinsics: the registration solves the pose with the
-// workspace's estimated camera.
+// pixels give their poses only; nothing is rendered from them. Aligning ground-truth poses with a
+// similarity instead carries the reconstruction's local pose errors into the novel cameras. Work
+// and logs go to `work_dir`; a second call with the same photos (names and bytes), the same model
+// and database size reuses the result. The photos are registered under prefixed names, so they may
+// share names with training photos. Returns an empty map and the reason when the workspace has no
+// database (e.g. made from known cameras) or COLMAP fails; throws BadInputError when report.json's
+// record of the features is damaged, and lets every other error through. The rendered targets keep
+// their own (ground-truth) intrinsics: the registration solves the pose with the workspace's
+// estimated camera.
 HeldOutRegistration RegisterHeldOutPhotos(const std::filesystem::path& workspace,
                                           const std::filesystem::path& images_dir,
                                           const std::vector<std::string>& names,

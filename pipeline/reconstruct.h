@@ -124,6 +124,10 @@ struct ReconstructSummary {
   std::string matcher;  // The matcher used, and why.
   std::string mapper;   // The mapper used, and why.
   std::string camera_model;
+  // The SIFT settings of --quality the photos' features were extracted with: photos registered
+  // into the model later (evaluate's held-out photos) are extracted the same way.
+  int feature_max_image_size = 0;
+  int feature_max_num_features = 0;
   int images_found = 0;
   int images_registered = 0;
   std::vector<std::string> unregistered;  // Names of photos not in the model.

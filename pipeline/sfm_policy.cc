@@ -128,15 +128,6 @@ std::string DescribeConversions(const PhotoSet& photos, const Workspace& workspa
   return note + ")";
 }
 
-QualitySettings SettingsFor(Quality quality) {
-  switch (quality) {
-    case Quality::kFast: return {1024, 2048, false};
-    case Quality::kBalanced: return {2000, 4096, false};
-    case Quality::kBest: return {3200, 8192, true};
-  }
-  throw std::invalid_argument("unknown quality");
-}
-
 int64_t VocabularyTreeWords(int num_images, int64_t descriptors) {
   const int64_t sampled = descriptors * std::min(num_images, kVocabularyTreeTrainingImages) /
                           std::max(num_images, 1);

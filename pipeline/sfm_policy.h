@@ -16,6 +16,7 @@
 #include "pipeline/key_photos.h"
 #include "pipeline/reconstruct.h"
 #include "sfm/photo_set.h"
+#include "sfm/quality_settings.h"
 
 namespace parallax {
 
@@ -60,14 +61,6 @@ std::vector<ExtractionRun> ExtractionRuns(const PhotoSet& photos, CameraSharing 
 // The sentence report.json notes for the photos converted into the workspace's readable copy
 // (Workspace::ReadablePhotos), or "" when there were none.
 std::string DescribeConversions(const PhotoSet& photos, const Workspace& workspace);
-
-// What a Quality asks of colmap's feature extraction and matching.
-struct QualitySettings {
-  int max_image_size;    // Long side in pixels the extractor scales the photos down to.
-  int max_num_features;  // Features kept per photo.
-  bool guided_matching;
-};
-QualitySettings SettingsFor(Quality quality);
 
 // COLMAP publishes trees of 32K words for sets of up to about 1,000 images. parallax builds
 // one from the features of at most 30 of the photos: colmap's k-means costs about 140 s of CPU

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <OpenImageIO/imagebuf.h>
 
 #include "core/atomic_file.h"
@@ -297,6 +298,52 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_LT(coarse.within_2pct, depth.within_2pct);
   EXPECT_GT(coarse.completeness, 0.6);
   EXPECT_LT(std::abs(coarse.signed_median), 0.002);
+}
+
+// The colmap feature_extractor command line `RegisterHeldOutPhotos` ran in `work`.
+std::string HeldOutExtraction(const std::filesystem::path& work) {
+  const std::string log = ReadFileBytes(work / "colmap.log");
+  const size_t start = log.find("$ ");
+  return start == std::string::npos ? log : log.substr(start, log.find('\n', start) - start);
+}
+
+// Held-out photos are extracted as the workspace's photos were (report.json records how):
+// at --quality fast's scale and feature count, not balanced's.
+TEST(Reconstruct, HeldOutPhotosAreExtractedAsTheWorkspacesPhotosWere) {
+  const TempDir workspace;
+  SilentProgress progress;
+  ReconstructOptions options;
+  options.quality = Quality::kFast;
+  options.estimate_depth = false;
+  Reconstruct(kSmall / "images", workspace.Path(), options, progress);
+  const SceneFolder scene{kSmall};
+  std::vector<std::string> names;
+  for (const SparseImage& image : ReadSparseModel(scene.Novel().sparse).Images()) names.push_back(image.name);
+
+  const HeldOutRegistration fast =
+      RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "fast", progress);
+  EXPECT_GE(fast.cam_from_world.size(), 3u) << fast.note;  // 3 of 4, as with balanced's.
+  const std::string fast_extraction = HeldOutExtraction(workspace.Path() / "fast");
+  EXPECT_NE(fast_extraction.find("--SiftExtraction.max_image_size 1024 --SiftExtraction.max_num_features 2048"),
+            std::string::npos) << fast_extraction;
+  EXPECT_NE(fast.note.find("1024 px, 2048 features"), std::string::npos) << fast.note;
+
+  // A report from before the settings were recorded: balanced's, as every workspace then had.
+  const std::filesystem::path report_path = Workspace(workspace.Path()).Report();
+  nlohmann::json report = nlohmann::json::parse(ReadFileBytes(report_path));
+  ASSERT_EQ(report["reconstruct"]["features"]["max_num_features"], 2048) << report.dump();
+  report["reconstruct"].erase("features");
+  WriteFileAtomically(report_path, report.dump());
+  RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "older", progress);
+  const std::string older_extraction = HeldOutExtraction(workspace.Path() / "older");
+  EXPECT_NE(older_extraction.find("--SiftExtraction.max_image_size 2000 --SiftExtraction.max_num_features 4096"),
+            std::string::npos) << older_extraction;
+
+  // A damaged record is the workspace's fault, said as such, not a note that nothing registered.
+  WriteFileAtomically(report_path, R"({"reconstruct": {"features": 7}})");
+  EXPECT_THROW(
+      RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "damaged", progress),
+      BadInputError);
 }
 
 TEST(Colmap, AFailingCommandNamesTheToolStatusAndLog) {
