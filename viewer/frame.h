@@ -3,6 +3,8 @@
 // (ViewCamera) and what comes back (FrameResult). No GL here: evaluation code (eval/) and other
 // CPU code share these types with the renderer without linking OpenGL (library
 // parallax::viewer_frame).
+#include <functional>
+
 #include <Eigen/Core>
 
 #include "core/camera.h"
@@ -10,6 +12,10 @@
 #include "core/pose.h"
 
 namespace parallax {
+
+// Seconds on a monotonic clock, read once a frame: auto exposure adapts over the time between
+// frames (SceneRenderer's clock: the steady clock's, or a test's that steps time itself).
+using FrameClock = std::function<double()>;
 
 // The most source photos projective texturing blends (FrameSettings::projective_views).
 constexpr int kMaxProjectors = 3;

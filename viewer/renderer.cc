@@ -1,6 +1,7 @@
 #include "viewer/renderer.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <span>
 #include <string_view>
@@ -119,7 +120,7 @@ struct SceneRenderer::Impl {
   bool with_aux = false;  // This frame fills the auxiliary target (Render).
   std::vector<std::string> notes, notes_given;
 
-  explicit Impl(const ViewerScene& s);
+  Impl(const ViewerScene& s, FrameClock clock);
   // NDC depth where the clip control is left: the light's and the projectors' maps.
   DepthRange Range() const { return clip_control ? DepthRange::kZeroToOne : DepthRange::kMinusOneToOne; }
   // Tells the user `note` the first time only (a skipped shadow method is skipped every frame).
@@ -138,11 +139,12 @@ struct SceneRenderer::Impl {
   void Blit(int framebuffer, int width, int height) const;
 };
 
-SceneRenderer::Impl::Impl(const ViewerScene& s)
+SceneRenderer::Impl::Impl(const ViewerScene& s, FrameClock clock)
     : scene(s),
       full_mesh(gpu::UploadMesh(s.mesh, s.ground)),
       display_mesh(gpu::UploadMesh(s.display_mesh, s.ground)),
-      overlays(s) {
+      overlays(s),
+      tone_mapper(std::move(clock)) {
   if (!s.points.empty()) points = gpu::Upload(PointVertices(s.points));
   for (const ColoredPoint& point : s.points) cloud_positions.push_back(point.position);
 }
@@ -153,7 +155,12 @@ void SceneRenderer::Impl::NoteOnce(const std::string& note) {
   notes.push_back(note);
 }
 
-SceneRenderer::SceneRenderer(const ViewerScene& scene) : impl_(std::make_unique<Impl>(scene)) {
+double SteadySeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+SceneRenderer::SceneRenderer(const ViewerScene& scene, FrameClock clock)
+    : impl_(std::make_unique<Impl>(scene, std::move(clock))) {
   impl_->clip_control = HasExtension("GL_ARB_clip_control");
   if (impl_->clip_control) glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
   glEnable(GL_PROGRAM_POINT_SIZE);

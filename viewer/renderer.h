@@ -22,10 +22,14 @@
 
 namespace parallax {
 
+// std::chrono::steady_clock's time in seconds: the renderer's clock unless it is given another.
+double SteadySeconds();
+
 class SceneRenderer {
  public:
-  // Uploads the scene. Throws std::runtime_error if a shader does not compile or GL fails.
-  explicit SceneRenderer(const ViewerScene& scene);
+  // Uploads the scene. `clock` times auto exposure's adaptation. Throws std::runtime_error if a
+  // shader does not compile or GL fails.
+  explicit SceneRenderer(const ViewerScene& scene, FrameClock clock = SteadySeconds);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;

@@ -2,14 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "viewer/shaders.h"
 
 namespace parallax {
 
-ToneMapper::ToneMapper()
-    : program_("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment), empty_vao_(MakeGlVertexArray()) {}
+ToneMapper::ToneMapper(FrameClock clock)
+    : program_("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment),
+      empty_vao_(MakeGlVertexArray()),
+      clock_(std::move(clock)) {}
 
 double ToneMapper::LogAverageLuminance(const gpu::EyeTarget& eye) {
   constexpr int kMeterWidth = 64, kMeterHeight = 36;
@@ -41,12 +44,12 @@ double ToneMapper::Exposure(const FrameSettings& settings, const gpu::EyeTarget&
   double exposure = std::exp2(settings.exposure_stops);
   if (!settings.auto_exposure) return exposure;
   const double luminance = LogAverageLuminance(eye);
-  const auto now = std::chrono::steady_clock::now();
+  const double now = clock_();
   if (!adapted_luminance_ || settings.adaptation_seconds <= 0) {
     adapted_luminance_ = luminance;
   } else {
     // The eye closes the gap to the frame's brightness exponentially in time.
-    const double dt = std::chrono::duration<double>(now - last_adaptation_).count();
+    const double dt = now - last_adaptation_;
     *adapted_luminance_ +=
         (luminance - *adapted_luminance_) * (1 - std::exp(-dt / static_cast<double>(settings.adaptation_seconds)));
   }

@@ -4,7 +4,6 @@
 // 8-bit sRGB frame by one screen-covering triangle. With auto exposure, a shrunk copy of the
 // float frame is read back for its log-average luminance, and the eye adapts towards it over
 // the settings' time constant. Needs a current GL context.
-#include <chrono>
 #include <optional>
 
 #include "viewer/frame.h"
@@ -15,8 +14,9 @@ namespace parallax {
 
 class ToneMapper {
  public:
-  // Throws std::runtime_error if the program does not compile.
-  ToneMapper();
+  // `clock` times the eye's adaptation. Throws std::runtime_error if the program does not
+  // compile.
+  explicit ToneMapper(FrameClock clock);
 
   // Exposes and maps eye.hdr into eye.color, then leaves the frame's draw buffers as they were:
   // the color, and the auxiliary target when `with_aux`.
@@ -33,8 +33,9 @@ class ToneMapper {
   GlVertexArray empty_vao_;  // The triangle has no vertex buffer.
   GlTexture meter_;          // The float frame shrunk, to read its brightness back.
   GlFramebuffer meter_framebuffer_;
+  FrameClock clock_;
   std::optional<double> adapted_luminance_;  // What the eye is adapted to (auto exposure).
-  std::chrono::steady_clock::time_point last_adaptation_;
+  double last_adaptation_ = 0;               // When, on clock_.
 };
 
 }  // namespace parallax
