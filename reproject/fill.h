@@ -42,6 +42,12 @@ struct FillOptions {
   void Check() const;  // Throws std::invalid_argument naming the field and value.
 };
 
+// Whether FillHoles fills a pixel of class `c`: holes, and out-of-view pixels with
+// fill_out_of_view.
+inline bool ShouldFill(PixelClass c, const FillOptions& options) {
+  return IsHole(c) || (options.fill_out_of_view && c == PixelClass::kOutOfView);
+}
+
 struct FillSummary {
   int filled_px = 0;  // Pixels that received a color.
   // Share of all pixels still without color after filling (holes nothing reached, and
