@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdlib>
-#include <cstring>
-#include <fstream>
 #include <iomanip>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -14,117 +11,18 @@
 
 #include "core/atomic_file.h"
 #include "core/error.h"
+#include "tests/core/sparse_model_example.h"
 
 namespace parallax {
 namespace {
 namespace fs = std::filesystem;
-
-constexpr uint64_t kBigPointId = (uint64_t{1} << 33) + 5;  // Beyond uint32, as COLMAP allows.
-
-// A fresh folder per test, removed when the test ends.
-class TempDir {
- public:
-  TempDir() {
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("parallax_" + std::string(test->test_suite_name()) + "_" + test->name() + "_" +
-             std::to_string(std::random_device()()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code error;
-    fs::remove_all(path_, error);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
-
-void WriteFile(const fs::path& path, const std::string& text) {
-  std::ofstream file(path, std::ios::binary);
-  file << text;
-}
-
-Camera MakeCamera(uint32_t id, CameraModel model, uint64_t width, uint64_t height,
-                  std::vector<double> params) {
-  Camera camera;
-  camera.id = id;
-  camera.model = model;
-  camera.width = width;
-  camera.height = height;
-  camera.params = std::move(params);
-  return camera;
-}
-
-SparseImage MakeImage(uint32_t id, uint32_t camera_id, std::string name,
-                      const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation,
-                      const std::vector<std::pair<Eigen::Vector2d, uint64_t>>& points) {
-  SparseImage image;
-  image.id = id;
-  image.camera_id = camera_id;
-  image.name = std::move(name);
-  // Set directly: the Rigid3d constructor would renormalise.
-  image.cam_from_world.rotation = rotation;
-  image.cam_from_world.translation = translation;
-  for (const auto& [xy, point3d_id] : points) image.points2d.push_back({xy, point3d_id});
-  return image;
-}
-
-// Three camera models, images with valid and invalid 2D points (one with none, in the middle,
-// so its empty line is followed by another image), 3D points out of id order, one with an empty
-// track and one with an id beyond uint32. Quaternions are built from 0, +-0.5 and +-1 so that
-// COLMAP's renormalisation leaves them bit for bit unchanged; other values use all 17 digits.
-SparseModel MakeModel() {
-  SparseModel model;
-  model.AddCamera(MakeCamera(7, CameraModel::kOpenCV, 800, 600,
-                             {600.5, 601.25, 400.125, 300.0625, 0.01, -0.002, 1e-4, -3e-5}));
-  model.AddCamera(
-      MakeCamera(1, CameraModel::kSimpleRadial, 640, 480, {1000.0 / 3, 320.5, 240.25, -0.0123}));
-  model.AddCamera(MakeCamera(2, CameraModel::kPinhole, 1920, 1080,
-                             {1234.5678901234567, 1234.0 / 7, 960.0, 540.5}));
-
-  const uint64_t none = kInvalidPoint3DId;
-  std::vector<SparseImage> images = {
-      MakeImage(2, 2, "dir/b.png", Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5),
-                Eigen::Vector3d(1.0 / 3, 2.0 / 3, -1e-3),
-                {{{10.5, 20.25}, 4},
-                 {{1.0 / 7, 1e-9}, 1},
-                 {{3, 4}, none},
-                 {{5.5, 6}, kBigPointId}}),
-      MakeImage(1, 1, "a.jpg", Eigen::Quaterniond(1, 0, 0, 0), Eigen::Vector3d(0.1, -0.2, 0.3),
-                {{{100.125, 200.0 / 3}, 1}, {{0, 0}, none}, {{639.75, 479.5}, 4}, {{-1, 2}, none}}),
-      MakeImage(5, 7, "c.jpg", Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5),
-                Eigen::Vector3d(-2.5e7, 0, 1e-12), {}),
-      MakeImage(9, 1, "d.jpg", Eigen::Quaterniond(0, 0, 0, 1), Eigen::Vector3d(5, 6, 7),
-                {{{1.5, 2.5}, 10}, {{3.25, 4.75}, none}, {{2.0 / 3, 5.0 / 9}, 1}}),
-  };
-
-  // Tracks are derived from the images' references, as COLMAP keeps them consistent.
-  std::vector<Point3D> points(5);
-  const uint64_t ids[] = {4, 1, kBigPointId, 10, 12};
-  for (size_t i = 0; i < points.size(); ++i) {
-    points[i].id = ids[i];
-    points[i].xyz = Eigen::Vector3d(0.1 * static_cast<double>(i) + 1.0 / 3, -2.0 / 7, 1e5 / 3);
-    points[i].rgb = Eigen::Matrix<uint8_t, 3, 1>(255, static_cast<uint8_t>(17 * i), 0);
-    points[i].error = i == 0 ? -1 : 0.1 * static_cast<double>(i) / 3;
-  }
-  for (const SparseImage& image : images) {
-    for (size_t k = 0; k < image.points2d.size(); ++k) {
-      for (Point3D& point : points) {
-        if (point.id == image.points2d[k].point3d_id) {
-          point.track.push_back({image.id, static_cast<uint32_t>(k)});
-        }
-      }
-    }
-  }
-  for (SparseImage& image : images) model.AddImage(std::move(image));
-  for (Point3D& point : points) model.AddPoint3D(std::move(point));
-  return model;
-}
+using sparse_model_example::kBigPointId;
+using sparse_model_example::MakeCamera;
+using sparse_model_example::MakeImage;
+using sparse_model_example::MakeModel;
+using sparse_model_example::TempDir;
+using sparse_model_example::WriteFile;
+using sparse_model_example::WriteTextModel;
 
 void ExpectSameBits(double a, double b, const std::string& what) {
   EXPECT_EQ(std::bit_cast<uint64_t>(a), std::bit_cast<uint64_t>(b))
@@ -237,26 +135,6 @@ std::string ColmapConvert(const TempDir& dir, const std::string& input, const st
          ReadFileBytes(log);
 }
 
-// The message of the BadInputError that reading `dir` throws; a failure if none is thrown.
-std::string ReadError(const fs::path& dir, SparseFormat format) {
-  try {
-    ReadSparseModel(dir, format);
-  } catch (const BadInputError& error) {
-    return error.what();
-  }
-  ADD_FAILURE() << "reading " << dir << " did not throw BadInputError";
-  return "";
-}
-
-// A text model folder with the given cameras.txt and images.txt and an empty points3D.txt.
-fs::path WriteTextModel(const TempDir& dir, const std::string& cameras, const std::string& images) {
-  const fs::path model = dir / "model";
-  fs::create_directories(model);
-  WriteFile(model / "cameras.txt", cameras);
-  WriteFile(model / "images.txt", images);
-  WriteFile(model / "points3D.txt", "");
-  return model;
-}
 
 TEST(SparseModel, TextRoundTripIsValueExact) {
   const TempDir dir;
@@ -417,119 +295,6 @@ TEST(SparseModel, ReadsTextWithCommentsBlankLinesAndCrlf) {
   EXPECT_TRUE(read.ImageById(2).points2d.empty());
   EXPECT_TRUE(read.ImageById(3).points2d.empty());
   EXPECT_EQ(read.FindImageByName("b.jpg"), &read.ImageById(2));
-}
-
-TEST(SparseModelErrors, TruncatedCamerasBinaryNamesTheFile) {
-  const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  const std::string bytes = ReadFileBytes(dir / "model" / "cameras.bin");
-  WriteFile(dir / "model" / "cameras.bin", bytes.substr(0, bytes.size() - 5));
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
-  EXPECT_NE(message.find("cameras.bin"), std::string::npos) << message;
-  EXPECT_NE(message.find("truncated in camera 3 of 3"), std::string::npos) << message;
-}
-
-// What a fuzzer would try first: no prefix of a valid file may crash or read out of bounds.
-TEST(SparseModelErrors, EveryTruncationOfABinaryFileIsReported) {
-  const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
-    const fs::path path = dir / "model" / name;
-    const std::string bytes = ReadFileBytes(path);
-    for (size_t size = 0; size < bytes.size(); ++size) {
-      WriteFile(path, bytes.substr(0, size));
-      const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
-      EXPECT_NE(message.find(name), std::string::npos) << size << " bytes: " << message;
-    }
-    WriteFile(path, bytes);
-  }
-}
-
-TEST(SparseModelErrors, HugeCountIsRefusedBeforeAllocating) {
-  const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  std::string bytes = ReadFileBytes(dir / "model" / "points3D.bin");
-  const uint64_t huge = uint64_t{1} << 60;
-  std::memcpy(bytes.data(), &huge, sizeof(huge));
-  WriteFile(dir / "model" / "points3D.bin", bytes);
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
-  EXPECT_NE(message.find("points3D.bin: " + std::to_string(huge) + " 3D points"),
-            std::string::npos)
-      << message;
-}
-
-TEST(SparseModelErrors, ImagesTextWithAMissingFieldNamesTheFileAndLine) {
-  const TempDir dir;
-  const fs::path model = WriteTextModel(dir, "1 PINHOLE 4 3 2 2 2 1.5\n",
-                                        "# images\n1 1 0 0 0 0 0 0 1\n\n");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("images.txt line 2: expected IMAGE_ID"), std::string::npos) << message;
-}
-
-TEST(SparseModelErrors, WrongCameraParameterCountNamesTheFileAndModel) {
-  const TempDir dir;
-  const fs::path model = WriteTextModel(dir, "# c\n# c\n# c\n1 PINHOLE 4 3 2 2 2\n", "");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("cameras.txt line 4: expected 4 parameters for PINHOLE, got 3"),
-            std::string::npos)
-      << message;
-}
-
-TEST(SparseModelErrors, UnknownCameraModelNameNamesTheFile) {
-  const TempDir dir;
-  const fs::path model = WriteTextModel(dir, "1 NOT_A_MODEL 4 3 2 2 2 1.5\n", "");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("cameras.txt line 1"), std::string::npos) << message;
-  EXPECT_NE(message.find("NOT_A_MODEL"), std::string::npos) << message;
-}
-
-TEST(SparseModelErrors, UnknownCameraModelIdNamesTheFile) {
-  const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  std::string bytes = ReadFileBytes(dir / "model" / "cameras.bin");
-  const int32_t bad_model = 99;
-  std::memcpy(bytes.data() + 8 + 4, &bad_model, sizeof(bad_model));
-  WriteFile(dir / "model" / "cameras.bin", bytes);
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
-  EXPECT_NE(message.find("cameras.bin: camera 1 of 3: unknown camera model id 99"),
-            std::string::npos)
-      << message;
-}
-
-TEST(SparseModelErrors, ImageWithAMissingCameraIsRefused) {
-  const TempDir dir;
-  const fs::path model =
-      WriteTextModel(dir, "1 PINHOLE 4 3 2 2 2 1.5\n", "1 1 0 0 0 0 0 0 8 a.jpg\n\n");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("images.txt line 1: camera id 8"), std::string::npos) << message;
-}
-
-TEST(SparseModelErrors, DuplicateIdsAreRefused) {
-  const TempDir dir;
-  const fs::path model =
-      WriteTextModel(dir, "1 PINHOLE 4 3 2 2 2 1.5\n1 PINHOLE 4 3 2 2 2 1.5\n", "");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("cameras.txt line 2: duplicate camera id 1"), std::string::npos)
-      << message;
-}
-
-TEST(SparseModelErrors, NonFiniteValuesAreRefused) {
-  const TempDir dir;
-  const fs::path model =
-      WriteTextModel(dir, "1 PINHOLE 4 3 2 2 2 1.5\n", "1 1 0 0 0 nan 0 0 1 a.jpg\n\n");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("images.txt line 1: non-finite TX 'nan'"), std::string::npos)
-      << message;
-}
-
-TEST(SparseModelErrors, TrackBeyondTheImagesPointsIsRefused) {
-  const TempDir dir;
-  const fs::path model =
-      WriteTextModel(dir, "1 PINHOLE 4 3 2 2 2 1.5\n", "1 1 0 0 0 0 0 0 1 a.jpg\n1 2 5\n");
-  WriteFile(model / "points3D.txt", "5 0 0 1 0 0 0 -1 1 3\n");
-  const std::string message = ReadError(model, SparseFormat::kText);
-  EXPECT_NE(message.find("3D point 5 track element (1, 3) is beyond"), std::string::npos)
-      << message;
 }
 
 }  // namespace
