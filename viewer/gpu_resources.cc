@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 #include <tuple>
 
@@ -60,7 +61,7 @@ std::vector<Eigen::Vector3f> FaceNormals(const TriangleMesh& mesh) {
 // meshes are not consistent, so a face pointing the other way counts with its sign flipped.
 std::vector<Eigen::Vector3f> CornerNormals(const TriangleMesh& mesh) {
   constexpr float kCreaseDeg = 40;
-  const float crease_cos = std::cos(kCreaseDeg * 3.14159265f / 180);
+  const float crease_cos = std::cos(kCreaseDeg * std::numbers::pi_v<float> / 180);
   const std::vector<Eigen::Vector3f> face = FaceNormals(mesh);
   // The faces around each vertex, as compressed rows.
   std::vector<int> first(mesh.vertices.size() + 1, 0), faces(mesh.triangles.size() * 3);

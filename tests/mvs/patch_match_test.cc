@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -119,7 +120,7 @@ TEST(PatchMatch, SlantedPlaneIsRecoveredWithItsNormal) {
   for (size_t i = 0; i < estimate.cost.size(); ++i) {
     if (!(estimate.depth.Values()[i] > 0)) continue;
     const Eigen::Vector3d n(estimate.normal[3 * i], estimate.normal[3 * i + 1], estimate.normal[3 * i + 2]);
-    angles.push_back(std::acos(std::clamp(std::abs(n.dot(expected)), 0.0, 1.0)) * 180 / M_PI);
+    angles.push_back(std::acos(std::clamp(std::abs(n.dot(expected)), 0.0, 1.0)) * 180 / std::numbers::pi);
   }
   ASSERT_FALSE(angles.empty());
   std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());

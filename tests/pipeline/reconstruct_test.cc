@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <numbers>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -104,7 +105,7 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
     const Rigid3d pose =
         evaluation.alignment.target_from_source.TransformPose(held_out.cam_from_world.at(image.name));
     const double angle_deg =
-        pose.rotation.angularDistance(image.cam_from_world.rotation) * 180 / 3.14159265358979;
+        pose.rotation.angularDistance(image.cam_from_world.rotation) * 180 / std::numbers::pi;
     // As accurate as the training cameras, within a factor of 2.
     EXPECT_LT(angle_deg, 2 * evaluation.rotation_error_max_deg) << image.name;
     EXPECT_LT((CameraCenter(pose) - CameraCenter(image.cam_from_world)).norm(),

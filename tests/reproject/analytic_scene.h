@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -20,8 +21,6 @@
 namespace parallax::test {
 
 using ColorFn = std::function<Eigen::Vector3f(const Eigen::Vector3d&)>;
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct Plane {
   Eigen::Vector3d normal;  // Unit.
@@ -129,7 +128,7 @@ inline PosedCamera CameraAt(const Camera& camera, const Eigen::Vector3d& center,
 // A smooth texture of the given world period around a base color (linear RGB).
 inline ColorFn WavyTexture(const Eigen::Vector3f& base, double period) {
   return [base, period](const Eigen::Vector3d& p) {
-    const double w = 2 * kPi / period;
+    const double w = 2 * std::numbers::pi / period;
     return Eigen::Vector3f(
         base(0) + static_cast<float>(0.15 * std::sin(w * p.x()) * std::cos(0.7 * w * p.y())),
         base(1) + static_cast<float>(0.15 * std::cos(w * p.y() + 0.3)),

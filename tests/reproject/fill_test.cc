@@ -1,6 +1,7 @@
 #include "reproject/fill.h"
 
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -220,7 +221,7 @@ TEST(FillHoles, SkyNothingSawContinuesTheSkyGradient) {
                            0.7f - 0.2f * static_cast<float>(d.y()));
   };
   const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
-  const double pitch = 12 * test::kPi / 180;
+  const double pitch = 12 * std::numbers::pi / 180;
   const PosedCamera target =
       CameraAt(camera, {0, 0, 0}, Eigen::Quaterniond(Eigen::AngleAxisd(-pitch, Eigen::Vector3d::UnitX())));
   const RenderResult result = Render({&source}, target);

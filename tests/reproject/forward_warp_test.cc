@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -200,7 +201,7 @@ TEST(ForwardWarp, PointsAtOrBehindTheTargetAreDropped) {
   const Camera camera = TestCamera();
   const SourceView source = test::RenderView(BoxScene(), CameraAt(camera, {0, 0, 0}));
   // Between box and wall, looking back at the box: the wall is behind the camera.
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitY()));
   const PosedCamera target = CameraAt(camera, {0, 0, 6}, turn);
   for (WarpMethod method : {WarpMethod::kMesh, WarpMethod::kSplat}) {
     ForwardWarpOptions options;
@@ -376,7 +377,7 @@ TEST(ForwardWarp, BicubicTextureFilterKeepsFineTextureSharper) {
   const double pixel_m = depth / focal;
   Scene scene;
   scene.planes.push_back(test::WallAt(depth, [&](const Eigen::Vector3d& p) {
-    const double phase = 2 * test::kPi * p.x() / (period_px * pixel_m);
+    const double phase = 2 * std::numbers::pi * p.x() / (period_px * pixel_m);
     const float stripe = static_cast<float>(0.3 * std::sin(phase));
     return Eigen::Vector3f(0.5f + stripe, 0.5f, 0.5f - stripe);
   }));

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
@@ -261,7 +262,7 @@ TEST(SourceSeeingMost, PicksTheViewThatSeesBehindTheOccluder) {
   const std::vector<Eigen::Vector3d> points = UnseenPoints(result, target);
   ASSERT_GT(points.size(), 500u);
   for (const Eigen::Vector3d& point : points) ASSERT_NEAR(point.z(), 8, 0.1);  // The wall.
-  const Eigen::Quaterniond away(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  const Eigen::Quaterniond away(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitY()));
   const std::vector<PosedCamera> candidates = {CameraAt(BoxCamera(), {-1.2, 0, 0}),
                                                CameraAt(BoxCamera(), {0, 0, 0}, away),
                                                CameraAt(BoxCamera(), {0.6, 0, 0})};
@@ -312,7 +313,7 @@ TEST(Render, TargetLookingAboveTheSourcesSkyIsOutOfViewNotAHole) {
     return Eigen::Vector3f(0.3f * k, 0.5f * k, 0.9f * k);
   };
   const SourceView source = test::RenderView(scene, CameraAt(camera, {0, 0, 0}));
-  const double tilt = 15 * test::kPi / 180;
+  const double tilt = 15 * std::numbers::pi / 180;
   const PosedCamera target{camera, LookAt({0.3, 0.4, 0}, {0.3, 0.4 - 10 * std::tan(tilt), 10},
                                           {0, -1, 0})};
   // The frustum test alone (the former classification) calls the top rows holes.
@@ -386,7 +387,7 @@ TEST(ClassCount, CountsEveryPixelOnceUnderItsClass) {
 TEST(Render, TargetInsideTheSceneStaysFinite) {
   const Scene scene = BoxScene();
   const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
-  const Eigen::Quaterniond turn(Eigen::AngleAxisd(test::kPi, Eigen::Vector3d::UnitY()));
+  const Eigen::Quaterniond turn(Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitY()));
   RenderAllWays({&source}, CameraAt(BoxCamera(), {0, 0, 6}, turn));  // Between box and wall.
   RenderAllWays({&source}, CameraAt(BoxCamera(), {0.2, 0.1, 4.5}));  // Inside the box.
   RenderAllWays({&source}, CameraAt(BoxCamera(), {0, 0, 9}));        // Behind the wall.

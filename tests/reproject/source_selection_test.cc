@@ -1,6 +1,7 @@
 #include "reproject/source_selection.h"
 
 #include <algorithm>
+#include <numbers>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -8,12 +9,10 @@
 namespace parallax {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 // Cameras on a circle of radius 5 around the origin, looking at it.
 PosedCamera RingCamera(double angle_deg) {
   const Camera camera = MakePinholeCamera(1, 320, 240, 280, 280, 160, 120);
-  const double a = angle_deg * kPi / 180;
+  const double a = angle_deg * std::numbers::pi / 180;
   return {camera, LookAt({5 * std::cos(a), 5 * std::sin(a), 1}, {0, 0, 0}, {0, 0, 1})};
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -10,8 +11,6 @@
 
 namespace parallax {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Camera SimpleRadial(double k) {
   Camera camera;
@@ -26,7 +25,7 @@ Camera SimpleRadial(double k) {
 // A smooth pattern (periods of 11 and 14 pixels) in [0.1, 0.9], at pixel coordinates with
 // centres at integer + 0.5.
 double Pattern(double x, double y) {
-  return 0.5 + 0.4 * std::sin(2 * kPi * x / 11) * std::cos(2 * kPi * y / 14);
+  return 0.5 + 0.4 * std::sin(2 * std::numbers::pi * x / 11) * std::cos(2 * std::numbers::pi * y / 14);
 }
 
 // An 8-bit photo whose pixel (x, y) shows what `at(x + 0.5, y + 0.5)` returns.

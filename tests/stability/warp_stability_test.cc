@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <optional>
 #include <string>
 
@@ -225,7 +226,7 @@ TEST(WarpStability, SourceRayLyingInTheTargetsCameraPlaneIsDroppedCleanly) {
 // at depth 5: a ceiling 8.7 mm above the source, filling the upper half of its image, depth
 // changing by a factor of ~2.5 from one row to the next near the horizon.
 Scene GrazingCeiling() {
-  const double tilt = (90 - 89.9) * test::kPi / 180;
+  const double tilt = (90 - 89.9) * std::numbers::pi / 180;
   const Eigen::Vector3d normal(0, -std::cos(tilt), std::sin(tilt));
   Scene scene;
   scene.planes.push_back(
@@ -245,8 +246,8 @@ TEST(WarpStability, GrazingSurfaceIsNotStretchedIntoSheets) {
   for (const float depth : source.depth.Values()) surface += depth > 0;
   ASSERT_GT(surface, kPixels / 3);
   const Eigen::Quaterniond pitch_up(
-      Eigen::AngleAxisd(-20 * test::kPi / 180, Eigen::Vector3d::UnitX()));
-  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(5 * test::kPi / 180, Eigen::Vector3d::UnitY()));
+      Eigen::AngleAxisd(-20 * std::numbers::pi / 180, Eigen::Vector3d::UnitX()));
+  const Eigen::Quaterniond yaw(Eigen::AngleAxisd(5 * std::numbers::pi / 180, Eigen::Vector3d::UnitY()));
   const PosedCamera targets[] = {CameraAt(WarpCamera(), {0, 0.5, 0}),
                                  CameraAt(WarpCamera(), {0.3, 0.2, 1}, pitch_up),
                                  CameraAt(WarpCamera(), {0, 0, 0}, yaw)};

@@ -1,6 +1,7 @@
 #include "synth/scene.h"
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -64,7 +65,7 @@ TEST(SceneJson, EveryKthCameraOfAHelixIsTheHelixOfFewerCameras) {
   EXPECT_NEAR(start.z(), 1, 1e-12);
   EXPECT_NEAR(half.z(), 2, 1e-12);
   EXPECT_LT((half.head<2>() - start.head<2>()).norm(), 1e-9);
-  EXPECT_NEAR(std::atan2(start.y(), start.x()) * 180 / 3.14159265358979, 10, 1e-9);
+  EXPECT_NEAR(std::atan2(start.y(), start.x()) * 180 / std::numbers::pi, 10, 1e-9);
   EXPECT_NE(ErrorOf(SceneWithRig(R"({"rig": "arc", "count": 2, "radius": 1, "turns": 2})"))
                 .find("belong to a ring"),
             std::string::npos);
