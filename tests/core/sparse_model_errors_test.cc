@@ -11,12 +11,12 @@
 #include "core/error.h"
 #include "core/sparse_model.h"
 #include "tests/core/sparse_model_example.h"
+#include "tests/temp_dir.h"
 
 namespace parallax {
 namespace {
 namespace fs = std::filesystem;
 using sparse_model_example::MakeModel;
-using sparse_model_example::TempDir;
 using sparse_model_example::WriteFile;
 using sparse_model_example::WriteTextModel;
 
@@ -33,10 +33,10 @@ std::string ReadError(const fs::path& dir, SparseFormat format) {
 
 TEST(SparseModelErrors, TruncatedCamerasBinaryNamesTheFile) {
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  const std::string bytes = ReadFileBytes(dir / "model" / "cameras.bin");
-  WriteFile(dir / "model" / "cameras.bin", bytes.substr(0, bytes.size() - 5));
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kBinary);
+  const std::string bytes = ReadFileBytes(dir.Path() / "model" / "cameras.bin");
+  WriteFile(dir.Path() / "model" / "cameras.bin", bytes.substr(0, bytes.size() - 5));
+  const std::string message = ReadError(dir.Path() / "model", SparseFormat::kBinary);
   EXPECT_NE(message.find("cameras.bin"), std::string::npos) << message;
   EXPECT_NE(message.find("truncated in camera 3 of 3"), std::string::npos) << message;
 }
@@ -44,13 +44,13 @@ TEST(SparseModelErrors, TruncatedCamerasBinaryNamesTheFile) {
 // What a fuzzer would try first: no prefix of a valid file may crash or read out of bounds.
 TEST(SparseModelErrors, EveryTruncationOfABinaryFileIsReported) {
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kBinary);
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
-    const fs::path path = dir / "model" / name;
+    const fs::path path = dir.Path() / "model" / name;
     const std::string bytes = ReadFileBytes(path);
     for (size_t size = 0; size < bytes.size(); ++size) {
       WriteFile(path, bytes.substr(0, size));
-      const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
+      const std::string message = ReadError(dir.Path() / "model", SparseFormat::kBinary);
       EXPECT_NE(message.find(name), std::string::npos) << size << " bytes: " << message;
     }
     WriteFile(path, bytes);
@@ -59,12 +59,12 @@ TEST(SparseModelErrors, EveryTruncationOfABinaryFileIsReported) {
 
 TEST(SparseModelErrors, HugeCountIsRefusedBeforeAllocating) {
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  std::string bytes = ReadFileBytes(dir / "model" / "points3D.bin");
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kBinary);
+  std::string bytes = ReadFileBytes(dir.Path() / "model" / "points3D.bin");
   const uint64_t huge = uint64_t{1} << 60;
   std::memcpy(bytes.data(), &huge, sizeof(huge));
-  WriteFile(dir / "model" / "points3D.bin", bytes);
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
+  WriteFile(dir.Path() / "model" / "points3D.bin", bytes);
+  const std::string message = ReadError(dir.Path() / "model", SparseFormat::kBinary);
   EXPECT_NE(message.find("points3D.bin: " + std::to_string(huge) + " 3D points"),
             std::string::npos)
       << message;
@@ -97,12 +97,12 @@ TEST(SparseModelErrors, UnknownCameraModelNameNamesTheFile) {
 
 TEST(SparseModelErrors, UnknownCameraModelIdNamesTheFile) {
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  std::string bytes = ReadFileBytes(dir / "model" / "cameras.bin");
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kBinary);
+  std::string bytes = ReadFileBytes(dir.Path() / "model" / "cameras.bin");
   const int32_t bad_model = 99;
   std::memcpy(bytes.data() + 8 + 4, &bad_model, sizeof(bad_model));
-  WriteFile(dir / "model" / "cameras.bin", bytes);
-  const std::string message = ReadError(dir / "model", SparseFormat::kBinary);
+  WriteFile(dir.Path() / "model" / "cameras.bin", bytes);
+  const std::string message = ReadError(dir.Path() / "model", SparseFormat::kBinary);
   EXPECT_NE(message.find("cameras.bin: camera 1 of 3: unknown camera model id 99"),
             std::string::npos)
       << message;

@@ -1,46 +1,22 @@
 #pragma once
 // The example model the sparse model tests write and read (sparse_model_test.cc,
-// sparse_model_errors_test.cc), and their folder per test.
+// sparse_model_errors_test.cc), and the files they write by hand.
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 #include "core/sparse_model.h"
+#include "tests/temp_dir.h"
 
 namespace parallax::sparse_model_example {
 namespace fs = std::filesystem;
 
 constexpr uint64_t kBigPointId = (uint64_t{1} << 33) + 5;  // Beyond uint32, as COLMAP allows.
-
-// A fresh folder per test, removed when the test ends.
-class TempDir {
- public:
-  TempDir() {
-    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("parallax_" + std::string(test->test_suite_name()) + "_" + test->name() + "_" +
-             std::to_string(std::random_device()()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code error;
-    fs::remove_all(path_, error);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
-};
 
 inline void WriteFile(const fs::path& path, const std::string& text) {
   std::ofstream file(path, std::ios::binary);
@@ -48,7 +24,7 @@ inline void WriteFile(const fs::path& path, const std::string& text) {
 }
 
 inline Camera MakeCamera(uint32_t id, CameraModel model, uint64_t width, uint64_t height,
-                  std::vector<double> params) {
+                         std::vector<double> params) {
   Camera camera;
   camera.id = id;
   camera.model = model;
@@ -59,8 +35,8 @@ inline Camera MakeCamera(uint32_t id, CameraModel model, uint64_t width, uint64_
 }
 
 inline SparseImage MakeImage(uint32_t id, uint32_t camera_id, std::string name,
-                      const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation,
-                      const std::vector<std::pair<Eigen::Vector2d, uint64_t>>& points) {
+                             const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation,
+                             const std::vector<std::pair<Eigen::Vector2d, uint64_t>>& points) {
   SparseImage image;
   image.id = id;
   image.camera_id = camera_id;
@@ -125,8 +101,9 @@ inline SparseModel MakeModel() {
 }
 
 // A text model folder with the given cameras.txt and images.txt and an empty points3D.txt.
-inline fs::path WriteTextModel(const TempDir& dir, const std::string& cameras, const std::string& images) {
-  const fs::path model = dir / "model";
+inline fs::path WriteTextModel(const TempDir& dir, const std::string& cameras,
+                               const std::string& images) {
+  const fs::path model = dir.Path() / "model";
   fs::create_directories(model);
   WriteFile(model / "cameras.txt", cameras);
   WriteFile(model / "images.txt", images);

@@ -12,6 +12,7 @@
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "tests/core/sparse_model_example.h"
+#include "tests/temp_dir.h"
 
 namespace parallax {
 namespace {
@@ -20,7 +21,6 @@ using sparse_model_example::kBigPointId;
 using sparse_model_example::MakeCamera;
 using sparse_model_example::MakeImage;
 using sparse_model_example::MakeModel;
-using sparse_model_example::TempDir;
 using sparse_model_example::WriteFile;
 using sparse_model_example::WriteTextModel;
 
@@ -114,7 +114,7 @@ void ExpectSameBytes(const fs::path& expected, const fs::path& actual) {
 void ExpectSameModelFiles(const TempDir& dir, const std::string& a, const std::string& b,
                           const std::string& extension) {
   for (const char* stem : {"cameras", "images", "points3D"}) {
-    ExpectSameBytes(dir / a / (stem + extension), dir / b / (stem + extension));
+    ExpectSameBytes(dir.Path() / a / (stem + extension), dir.Path() / b / (stem + extension));
   }
 }
 
@@ -123,11 +123,11 @@ bool HaveColmap() { return std::system("command -v colmap > /dev/null 2>&1") == 
 // Runs `colmap model_converter`; returns an empty string on success, else what went wrong.
 std::string ColmapConvert(const TempDir& dir, const std::string& input, const std::string& output,
                           const std::string& output_type) {
-  fs::create_directories(dir / output);
-  const fs::path log = dir / (output + ".log");
+  fs::create_directories(dir.Path() / output);
+  const fs::path log = dir.Path() / (output + ".log");
   const std::string command =
-      "QT_QPA_PLATFORM=offscreen colmap model_converter --input_path '" + (dir / input).string() +
-      "' --output_path '" + (dir / output).string() + "' --output_type " + output_type + " > '" +
+      "QT_QPA_PLATFORM=offscreen colmap model_converter --input_path '" + (dir.Path() / input).string() +
+      "' --output_path '" + (dir.Path() / output).string() + "' --output_type " + output_type + " > '" +
       log.string() + "' 2>&1";
   const int status = std::system(command.c_str());
   if (status == 0) return "";
@@ -142,11 +142,11 @@ TEST(SparseModel, TextRoundTripIsValueExact) {
   // Not unit length: values are kept as read, never renormalised.
   model.MutableImages()[0].cam_from_world.rotation =
       Eigen::Quaterniond(0.1234567890123456789, 0.2 / 3, -0.3 / 7, 0.987654321);
-  WriteSparseModel(model, dir / "a", SparseFormat::kText);
-  const SparseModel read = ReadSparseModel(dir / "a", SparseFormat::kText);
+  WriteSparseModel(model, dir.Path() / "a", SparseFormat::kText);
+  const SparseModel read = ReadSparseModel(dir.Path() / "a", SparseFormat::kText);
   ExpectSameModel(model, read);
 
-  WriteSparseModel(read, dir / "b", SparseFormat::kText);
+  WriteSparseModel(read, dir.Path() / "b", SparseFormat::kText);
   ExpectSameModelFiles(dir, "a", "b", ".txt");
 }
 
@@ -155,19 +155,19 @@ TEST(SparseModel, BinaryRoundTripIsByteExact) {
   SparseModel model = MakeModel();
   model.MutableImages()[0].cam_from_world.rotation =
       Eigen::Quaterniond(0.1234567890123456789, 0.2 / 3, -0.3 / 7, 0.987654321);
-  WriteSparseModel(model, dir / "a", SparseFormat::kBinary);
-  const SparseModel read = ReadSparseModel(dir / "a", SparseFormat::kBinary);
+  WriteSparseModel(model, dir.Path() / "a", SparseFormat::kBinary);
+  const SparseModel read = ReadSparseModel(dir.Path() / "a", SparseFormat::kBinary);
   ExpectSameModel(model, read);
 
-  WriteSparseModel(read, dir / "b", SparseFormat::kBinary);
+  WriteSparseModel(read, dir.Path() / "b", SparseFormat::kBinary);
   ExpectSameModelFiles(dir, "a", "b", ".bin");
 }
 
 TEST(SparseModel, WithoutKeypointsKeepsCamerasPosesAndTracks) {
   const TempDir dir;
   const SparseModel model = MakeModel();
-  WriteSparseModel(model, dir / "model", SparseFormat::kBinary);
-  const SparseModel read = ReadSparseModelWithoutKeypoints(dir / "model");
+  WriteSparseModel(model, dir.Path() / "model", SparseFormat::kBinary);
+  const SparseModel read = ReadSparseModelWithoutKeypoints(dir.Path() / "model");
   ASSERT_EQ(read.Images().size(), model.Images().size());
   ASSERT_GT(model.Images()[0].points2d.size(), 0u);
   for (size_t i = 0; i < model.Images().size(); ++i) {
@@ -229,42 +229,42 @@ TEST(SparseModel, SelectPointsKeepsEveryImageObservingOnlyThem) {
 
 TEST(SparseModel, DetectsTheFormatFromTheFilesPresent) {
   const TempDir dir;
-  EXPECT_EQ(DetectSparseFormat(dir / "model"), std::nullopt);
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kText);
-  EXPECT_EQ(DetectSparseFormat(dir / "model"), SparseFormat::kText);
-  WriteSparseModel(MakeModel(), dir / "model", SparseFormat::kBinary);
-  EXPECT_EQ(DetectSparseFormat(dir / "model"), SparseFormat::kBinary);
-  ExpectSameModel(MakeModel(), ReadSparseModel(dir / "model"));
+  EXPECT_EQ(DetectSparseFormat(dir.Path() / "model"), std::nullopt);
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kText);
+  EXPECT_EQ(DetectSparseFormat(dir.Path() / "model"), SparseFormat::kText);
+  WriteSparseModel(MakeModel(), dir.Path() / "model", SparseFormat::kBinary);
+  EXPECT_EQ(DetectSparseFormat(dir.Path() / "model"), SparseFormat::kBinary);
+  ExpectSameModel(MakeModel(), ReadSparseModel(dir.Path() / "model"));
 
-  fs::remove(dir / "model" / "points3D.bin");
-  fs::remove(dir / "model" / "points3D.txt");
-  EXPECT_EQ(DetectSparseFormat(dir / "model"), std::nullopt);
-  EXPECT_THROW(ReadSparseModel(dir / "model"), BadInputError);
+  fs::remove(dir.Path() / "model" / "points3D.bin");
+  fs::remove(dir.Path() / "model" / "points3D.txt");
+  EXPECT_EQ(DetectSparseFormat(dir.Path() / "model"), std::nullopt);
+  EXPECT_THROW(ReadSparseModel(dir.Path() / "model"), BadInputError);
 }
 
 TEST(SparseModel, ColmapReadsOurBinaryAsTheSameModel) {
   ASSERT_TRUE(HaveColmap()) << "colmap is not on PATH: run scripts/install-deps";
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "ours", SparseFormat::kBinary);
+  WriteSparseModel(MakeModel(), dir.Path() / "ours", SparseFormat::kBinary);
   ASSERT_EQ(ColmapConvert(dir, "ours", "colmap", "TXT"), "");
-  ExpectSameModelIgnoringOrder(MakeModel(), ReadSparseModel(dir / "colmap", SparseFormat::kText));
+  ExpectSameModelIgnoringOrder(MakeModel(), ReadSparseModel(dir.Path() / "colmap", SparseFormat::kText));
 }
 
 TEST(SparseModel, ColmapReadsOurTextAsTheSameModel) {
   ASSERT_TRUE(HaveColmap()) << "colmap is not on PATH: run scripts/install-deps";
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "ours", SparseFormat::kText);
+  WriteSparseModel(MakeModel(), dir.Path() / "ours", SparseFormat::kText);
   ASSERT_EQ(ColmapConvert(dir, "ours", "colmap", "BIN"), "");
   ExpectSameModelIgnoringOrder(MakeModel(),
-                               ReadSparseModel(dir / "colmap", SparseFormat::kBinary));
+                               ReadSparseModel(dir.Path() / "colmap", SparseFormat::kBinary));
 }
 
 TEST(SparseModel, RewritingColmapBinaryReproducesItsBytes) {
   ASSERT_TRUE(HaveColmap()) << "colmap is not on PATH: run scripts/install-deps";
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "ours", SparseFormat::kText);
+  WriteSparseModel(MakeModel(), dir.Path() / "ours", SparseFormat::kText);
   ASSERT_EQ(ColmapConvert(dir, "ours", "colmap", "BIN"), "");
-  WriteSparseModel(ReadSparseModel(dir / "colmap", SparseFormat::kBinary), dir / "rewritten",
+  WriteSparseModel(ReadSparseModel(dir.Path() / "colmap", SparseFormat::kBinary), dir.Path() / "rewritten",
                    SparseFormat::kBinary);
   ExpectSameModelFiles(dir, "colmap", "rewritten", ".bin");
 }
@@ -273,9 +273,9 @@ TEST(SparseModel, RewritingColmapBinaryReproducesItsBytes) {
 TEST(SparseModel, RewritingColmapTextReproducesItsBytes) {
   ASSERT_TRUE(HaveColmap()) << "colmap is not on PATH: run scripts/install-deps";
   const TempDir dir;
-  WriteSparseModel(MakeModel(), dir / "ours", SparseFormat::kBinary);
+  WriteSparseModel(MakeModel(), dir.Path() / "ours", SparseFormat::kBinary);
   ASSERT_EQ(ColmapConvert(dir, "ours", "colmap", "TXT"), "");
-  WriteSparseModel(ReadSparseModel(dir / "colmap", SparseFormat::kText), dir / "rewritten",
+  WriteSparseModel(ReadSparseModel(dir.Path() / "colmap", SparseFormat::kText), dir.Path() / "rewritten",
                    SparseFormat::kText);
   ExpectSameModelFiles(dir, "colmap", "rewritten", ".txt");
 }
