@@ -318,8 +318,9 @@ TEST(Reconstruct, HeldOutPhotosAreExtractedAsTheWorkspacesPhotosWere) {
   options.estimate_depth = false;
   Reconstruct(kSmall / "images", workspace.Path(), options, progress);
   const SceneFolder scene{kSmall};
+  const SparseModel novel = ReadSparseModel(scene.Novel().sparse);
   std::vector<std::string> names;
-  for (const SparseImage& image : ReadSparseModel(scene.Novel().sparse).Images()) names.push_back(image.name);
+  for (const SparseImage& image : novel.Images()) names.push_back(image.name);
 
   const HeldOutRegistration fast =
       RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "fast", progress);
