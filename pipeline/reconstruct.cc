@@ -16,7 +16,6 @@
 #include "core/workspace_lock.h"
 #include "pipeline/dense_stages.h"
 #include "pipeline/sfm_stages.h"
-#include "sfm/quality_settings.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -99,8 +98,8 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
           {"mapper", summary.mapper},
           {"camera_model", summary.camera_model},
           {"features",
-           {{"max_image_size", summary.feature_max_image_size},
-            {"max_num_features", summary.feature_max_num_features}}},
+           {{"max_image_size", summary.features.max_image_size},
+            {"max_num_features", summary.features.max_num_features}}},
           {"skipped_files", skipped_files},
           {"stages", stages},
           {"timings_s", timings},
@@ -309,9 +308,7 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
                        HeldOutPhotos(PhotoNames(photos), options.hold_out_every, options.hold_out_photos)};
   summary.camera_model = DescribeCameraSetup(sfm.camera, photos);
   summary.matcher = PlannedMatcher(options, num_images);
-  const QualitySettings sift = SettingsFor(options.quality);
-  summary.feature_max_image_size = sift.max_image_size;
-  summary.feature_max_num_features = sift.max_num_features;
+  summary.features = SettingsFor(options.quality);
   if (!options.vocab_tree.empty() && sfm.matcher == MatcherChoice::kExhaustive) {
     summary.notes.push_back("vocabulary tree " + options.vocab_tree.string() +
                             " not used: exhaustive matching pairs every image without one");

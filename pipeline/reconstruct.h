@@ -16,6 +16,7 @@
 #include "pipeline/stage_graph.h"
 #include "sfm/photo_set.h"
 #include "sfm/plausibility.h"
+#include "sfm/quality_settings.h"
 
 namespace parallax {
 
@@ -124,10 +125,9 @@ struct ReconstructSummary {
   std::string matcher;  // The matcher used, and why.
   std::string mapper;   // The mapper used, and why.
   std::string camera_model;
-  // The SIFT settings of --quality the photos' features were extracted with: photos registered
-  // into the model later (evaluate's held-out photos) are extracted the same way.
-  int feature_max_image_size = 0;
-  int feature_max_num_features = 0;
+  // The settings of --quality the photos' features were extracted with: photos registered into
+  // the model later (evaluate's held-out photos) are extracted the same way.
+  QualitySettings features{};
   int images_found = 0;
   int images_registered = 0;
   std::vector<std::string> unregistered;  // Names of photos not in the model.
