@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
@@ -160,7 +161,9 @@ void RegisterReconstructCommand(CLI::App& app) {
                   "views per depth task");
   command->callback([arguments, command] {
     ReconstructOptions options = arguments->options;
-    options.camera_model = CameraModelFromName(arguments->camera_model);
+    const std::optional<CameraModel> camera_model = CameraModelNamed(arguments->camera_model);
+    if (!camera_model) throw UsageError("--camera-model: unknown camera model '" + arguments->camera_model + "'");
+    options.camera_model = *camera_model;
     options.estimate_depth = !arguments->no_depth;
     options.build_mesh = !arguments->no_depth && !arguments->no_mesh;
     if (!arguments->intrinsics.empty()) options.intrinsics = ParseNumberList(arguments->intrinsics, "--intrinsics");

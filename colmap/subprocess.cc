@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "core/error.h"
 #include "core/interrupt.h"
 
 extern char** environ;
@@ -68,7 +69,7 @@ std::string FindExecutable(const std::string& name) {
 ProcessResult RunProcess(const std::vector<std::string>& argv,
                          const std::vector<std::string>& extra_environment,
                          const std::function<void(std::string_view line)>& on_line) {
-  if (argv.empty()) throw std::invalid_argument("RunProcess: empty command line");
+  if (argv.empty()) throw InternalError("RunProcess: empty command line");
   int fds[2];
   if (::pipe(fds) != 0) throw std::runtime_error("cannot create a pipe: " + std::string(std::strerror(errno)));
   FileDescriptor read_end(fds[0]), write_end(fds[1]);

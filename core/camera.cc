@@ -3,7 +3,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -32,7 +33,7 @@ constexpr std::array<ModelInfo, 11> kModels = {{
 const ModelInfo& Info(CameraModel model) {
   const int id = static_cast<int>(model);
   if (id < 0 || id >= static_cast<int>(kModels.size())) {
-    throw std::invalid_argument("unknown camera model id " + std::to_string(id));
+    throw InternalError("unknown camera model id " + std::to_string(id));
   }
   return kModels[static_cast<size_t>(id)];
 }
@@ -52,8 +53,8 @@ Eigen::Vector2d RadialCoefficients(const Camera& camera) {
 
 void RequireProjection(const Camera& camera) {
   if (!IsProjectionSupported(camera.model)) {
-    throw std::invalid_argument("camera model " + std::string(CameraModelName(camera.model)) +
-                                " is read and written, but not projected by parallax");
+    throw InternalError("camera model " + std::string(CameraModelName(camera.model)) +
+                        " is read and written, but not projected by parallax");
   }
 }
 
@@ -66,14 +67,17 @@ constexpr double kNewtonTolerance = 1e-14;
 
 std::string_view CameraModelName(CameraModel model) { return Info(model).name; }
 
-CameraModel CameraModelFromName(std::string_view name) {
+std::optional<CameraModel> CameraModelNamed(std::string_view name) {
   for (const ModelInfo& info : kModels) {
     if (info.name == name) return info.model;
   }
-  throw std::invalid_argument("unknown camera model '" + std::string(name) + "'");
+  return std::nullopt;
 }
 
-CameraModel CameraModelFromId(int id) { return Info(static_cast<CameraModel>(id)).model; }
+std::optional<CameraModel> CameraModelWithId(int id) {
+  if (id < 0 || id >= static_cast<int>(kModels.size())) return std::nullopt;
+  return kModels[static_cast<size_t>(id)].model;
+}
 
 int NumCameraParams(CameraModel model) { return Info(model).num_params; }
 
@@ -81,25 +85,24 @@ bool IsProjectionSupported(CameraModel model) {
   return static_cast<int>(model) >= 0 && static_cast<int>(model) <= 4;
 }
 
-void Camera::Check() const {
-  const std::string where = "camera " + std::to_string(id) + " (" +
-                            std::string(CameraModelName(model)) + ")";
+std::string Camera::Problem() const {
+  const std::string where = "camera " + std::to_string(id) + " (" + std::string(CameraModelName(model)) + ")";
   if (static_cast<int>(params.size()) != NumCameraParams(model)) {
-    throw std::invalid_argument(where + ": expected " + std::to_string(NumCameraParams(model)) +
-                                " parameters, got " + std::to_string(params.size()));
+    return where + ": expected " + std::to_string(NumCameraParams(model)) + " parameters, got " +
+           std::to_string(params.size());
   }
   if (width == 0 || height == 0) {
-    throw std::invalid_argument(where + ": image size " + std::to_string(width) + "x" +
-                                std::to_string(height) + " is empty");
+    return where + ": image size " + std::to_string(width) + "x" + std::to_string(height) + " is empty";
   }
   for (size_t i = 0; i < params.size(); ++i) {
-    if (!std::isfinite(params[i])) {
-      throw std::invalid_argument(where + ": parameter " + std::to_string(i) + " is not finite");
-    }
+    if (!std::isfinite(params[i])) return where + ": parameter " + std::to_string(i) + " is not finite";
   }
-  if (!(FocalX() > 0 && FocalY() > 0)) {
-    throw std::invalid_argument(where + ": focal length must be positive");
-  }
+  if (!(FocalX() > 0 && FocalY() > 0)) return where + ": focal length must be positive";
+  return "";
+}
+
+void Camera::Check() const {
+  if (std::string problem = Problem(); !problem.empty()) throw InternalError(problem);
 }
 
 double Camera::FocalX() const { return params.at(0); }

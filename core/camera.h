@@ -33,12 +33,12 @@ enum class CameraModel : int {
   kThinPrismFisheye = 10,   // read and written only
 };
 
-// COLMAP's name ("SIMPLE_RADIAL"); throws std::invalid_argument for an unknown id.
+// COLMAP's name ("SIMPLE_RADIAL"); throws InternalError for a value outside the enum.
 std::string_view CameraModelName(CameraModel model);
-// Inverse of CameraModelName; throws std::invalid_argument naming the unknown string.
-CameraModel CameraModelFromName(std::string_view name);
-// Throws std::invalid_argument for an id outside COLMAP's models.
-CameraModel CameraModelFromId(int id);
+// Inverse of CameraModelName: std::nullopt for a name COLMAP does not have.
+std::optional<CameraModel> CameraModelNamed(std::string_view name);
+// The model with COLMAP's id, or std::nullopt for an id outside COLMAP's models.
+std::optional<CameraModel> CameraModelWithId(int id);
 // Number of parameters COLMAP stores for the model.
 int NumCameraParams(CameraModel model);
 // Whether project/unproject are implemented for the model (the five models above).
@@ -51,8 +51,10 @@ struct Camera {
   uint64_t height = 0;  // Pixels.
   std::vector<double> params;  // COLMAP's order for `model`.
 
-  // Throws std::invalid_argument if the parameter count does not fit the model, the size is
-  // zero, or a parameter is not finite.
+  // What makes the camera unusable (the parameter count does not fit the model, the size is
+  // zero, a parameter is not finite, a focal length is not positive), or "" when it is usable.
+  std::string Problem() const;
+  // Throws InternalError with the Problem() unless it is "".
   void Check() const;
 
   double FocalX() const;

@@ -1,8 +1,9 @@
 #include "core/check.h"
 
 #include <cstdio>
-#include <stdexcept>
 #include <string>
+
+#include "core/error.h"
 
 namespace parallax {
 
@@ -10,8 +11,7 @@ void RequireOption(bool ok, std::string_view field, double value, std::string_vi
   if (ok) return;
   char number[32];
   std::snprintf(number, sizeof(number), "%.9g", value);
-  throw std::invalid_argument(std::string(field) + " = " + number + ": expected " +
-                              std::string(expected));
+  throw UsageError(std::string(field) + " = " + number + ": expected " + std::string(expected));
 }
 
 }  // namespace parallax

@@ -1,11 +1,12 @@
 #pragma once
-// The one way an Options::Check() refuses a value: std::invalid_argument naming the field, its
-// value and what was expected, e.g. "ForwardWarpOptions.max_slant_deg = 95: expected (0, 90)".
+// The one way an Options::Check() refuses a value: UsageError (options come from the command
+// line) naming the field, its value and what was expected, e.g.
+// "ForwardWarpOptions.max_slant_deg = 95: expected (0, 90)".
 #include <string_view>
 
 namespace parallax {
 
-// Throws std::invalid_argument unless `ok`.
+// Throws UsageError unless `ok`.
 void RequireOption(bool ok, std::string_view field, double value, std::string_view expected);
 
 }  // namespace parallax

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
@@ -43,7 +42,7 @@ ColorGains ReadColorGains(const std::filesystem::path& path) {
 
 void WriteColorGains(const std::filesystem::path& path, const ColorGains& gains) {
   for (const auto& [photo, gain] : gains.by_photo) {
-    if (!ValidGain(gain)) throw std::invalid_argument("WriteColorGains: gain of " + photo + " is not positive");
+    if (!ValidGain(gain)) throw InternalError("WriteColorGains: gain of " + photo + " is not positive");
   }
   WriteFileAtomically(path, nlohmann::json{{"photos", gains.by_photo}}.dump(2) + "\n");
 }

@@ -23,7 +23,7 @@ struct ColorGains {
 // The file is {"photos": {"<name>": [r, g, b], ...}}. Reading throws BadInputError naming the
 // file for malformed JSON or a gain that is not a positive finite number.
 ColorGains ReadColorGains(const std::filesystem::path& path);
-// Written atomically; throws std::invalid_argument for a gain that is not positive and finite.
+// Written atomically; throws InternalError for a gain that is not positive and finite.
 void WriteColorGains(const std::filesystem::path& path, const ColorGains& gains);
 
 // Multiplies each pixel's first three channels (linear light) by `gain`.

@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
-#include <stdexcept>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
@@ -44,8 +43,8 @@ void CheckReadDepth(const std::vector<float>& values, const fs::path& path) {
 void CheckWrittenDepth(const DepthMap& depth, const fs::path& path) {
   const int64_t bad = FindInvalidDepth(depth.Values());
   if (bad >= 0) {
-    throw std::invalid_argument("writing " + path.string() + ": " +
-                                DescribeInvalidDepth(depth.Values(), bad));
+    throw InternalError("writing " + path.string() + ": " +
+                        DescribeInvalidDepth(depth.Values(), bad));
   }
 }
 
@@ -72,8 +71,8 @@ DepthMap::DepthMap(int width, int height) { Reset(width, height); }
 
 void DepthMap::Reset(int width, int height) {
   if (width < 0 || height < 0) {
-    throw std::invalid_argument("DepthMap: invalid size " + std::to_string(width) + "x" +
-                                std::to_string(height));
+    throw InternalError("DepthMap: invalid size " + std::to_string(width) + "x" +
+                        std::to_string(height));
   }
   width_ = width;
   height_ = height;
@@ -162,11 +161,11 @@ DenseArray ReadColmapArray(const fs::path& path) {
 void WriteColmapArray(const fs::path& path, const DenseArray& array) {
   const size_t count = static_cast<size_t>(array.width) * array.height * array.channels;
   if (array.width <= 0 || array.height <= 0 || array.channels <= 0 || array.values.size() != count) {
-    throw std::invalid_argument("WriteColmapArray " + path.string() + ": size does not match data");
+    throw InternalError("WriteColmapArray " + path.string() + ": size does not match data");
   }
   for (const float value : array.values) {
     if (!std::isfinite(value)) {
-      throw std::invalid_argument("WriteColmapArray " + path.string() + ": NaN or Inf in data");
+      throw InternalError("WriteColmapArray " + path.string() + ": NaN or Inf in data");
     }
   }
   std::string bytes = std::to_string(array.width) + "&" + std::to_string(array.height) + "&" +

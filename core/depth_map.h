@@ -17,7 +17,7 @@ namespace parallax {
 class DepthMap {
  public:
   DepthMap() = default;
-  // Zero-filled ("no value" everywhere). Throws std::invalid_argument for negative sizes.
+  // Zero-filled ("no value" everywhere). Throws InternalError for negative sizes.
   DepthMap(int width, int height);
   // As a new DepthMap(width, height), keeping the memory when it is large enough.
   void Reset(int width, int height);
@@ -57,7 +57,7 @@ struct DenseArray {
 // values, NaN or Inf.
 DepthMap ReadDepthExr(const std::filesystem::path& path);
 // Writes one float32 channel named "Z", ZIP-compressed (lossless), atomically. Throws
-// std::invalid_argument for negative, NaN or Inf values.
+// InternalError for negative, NaN or Inf values.
 void WriteDepthExr(const std::filesystem::path& path, const DepthMap& depth);
 
 // COLMAP dense `.bin`. The reader checks the header against the file size before allocating

@@ -5,7 +5,6 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
@@ -25,7 +24,7 @@ OIIO::TypeDesc ToTypeDesc(PixelFormat format) {
     case PixelFormat::kHalf: return OIIO::TypeDesc::HALF;
     case PixelFormat::kFloat: return OIIO::TypeDesc::FLOAT;
   }
-  throw std::invalid_argument("unknown pixel format");
+  throw InternalError("unknown pixel format");
 }
 
 bool HasAlpha(const Image& image) { return image.Channels() == 2 || image.Channels() == 4; }
@@ -110,8 +109,8 @@ Image::Image(int width, int height, int channels) { Reset(width, height, channel
 
 void Image::Reset(int width, int height, int channels) {
   if (width < 0 || height < 0 || channels < 1 || channels > 4) {
-    throw std::invalid_argument("Image: invalid size " + std::to_string(width) + "x" +
-                                std::to_string(height) + "x" + std::to_string(channels));
+    throw InternalError("Image: invalid size " + std::to_string(width) + "x" +
+                        std::to_string(height) + "x" + std::to_string(channels));
   }
   width_ = width;
   height_ = height;
@@ -179,10 +178,10 @@ Image ReadImage(const fs::path& path) {
 
 void WriteImage(const fs::path& path, const Image& image, PixelFormat format,
                 PngCompression png) {
-  if (image.Empty()) throw std::invalid_argument("WriteImage " + path.string() + ": empty image");
+  if (image.Empty()) throw InternalError("WriteImage " + path.string() + ": empty image");
   for (const float value : image.Pixels()) {
     if (!std::isfinite(value)) {
-      throw std::invalid_argument("WriteImage " + path.string() + ": NaN or Inf in the image");
+      throw InternalError("WriteImage " + path.string() + ": NaN or Inf in the image");
     }
   }
   WriteAtomically(path, [&](const fs::path& temporary) {

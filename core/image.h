@@ -20,7 +20,7 @@ namespace parallax {
 class Image {
  public:
   Image() = default;
-  // Zero-filled. Throws std::invalid_argument for channels outside 1..4 or negative sizes.
+  // Zero-filled. Throws InternalError for channels outside 1..4 or negative sizes.
   Image(int width, int height, int channels);
   // As a new Image(width, height, channels), keeping the memory when it is large enough: a
   // frame loop that reuses its images does not page-fault megabytes of fresh memory per frame.
@@ -85,7 +85,7 @@ Image ReadImage(const std::filesystem::path& path);
 enum class PngCompression { kFast, kSmall };
 
 // Writes `image` in the format the extension names, integer formats rounding [0, 1] values
-// (clamped). Throws std::invalid_argument if a value is NaN or Inf, BadInputError if the file
+// (clamped). Throws InternalError if a value is NaN or Inf, BadInputError if the file
 // cannot be written. EXR is written with lossless ZIP compression, PNG as `png` says.
 void WriteImage(const std::filesystem::path& path, const Image& image, PixelFormat format,
                 PngCompression png = PngCompression::kFast);

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -10,7 +11,7 @@ namespace {
 void CheckPair(const Image& image, const Image& reference) {
   if (image.Width() != reference.Width() || image.Height() != reference.Height() ||
       image.Channels() < 3 || reference.Channels() < 3) {
-    throw std::invalid_argument("image metrics: need two RGB images of the same size");
+    throw InternalError("image metrics: need two RGB images of the same size");
   }
 }
 

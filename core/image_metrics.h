@@ -10,7 +10,7 @@ namespace parallax {
 
 // Peak signal-to-noise ratio in dB over the pixels where `mask` is non-zero (all pixels for an
 // empty mask). Identical images give 100 dB (the MSE is floored at 1e-10), no pixel gives 0.
-// Throws std::invalid_argument for images of different sizes or with fewer than 3 channels.
+// Throws InternalError for images of different sizes or with fewer than 3 channels.
 double Psnr(const Image& image, const Image& reference, const std::vector<uint8_t>& mask = {});
 
 // Mean structural similarity (Wang et al. 2004: Gaussian window, sigma 1.5, radius 5,

@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
+
+#include "core/error.h"
 
 namespace parallax {
 
@@ -11,8 +12,7 @@ Rigid3d::Rigid3d(const Eigen::Quaterniond& rotation_in, const Eigen::Vector3d& t
     : rotation(rotation_in), translation(translation_in) {
   const double norm = rotation.norm();
   if (!(norm > 0) || !std::isfinite(norm) || !translation.allFinite()) {
-    throw std::invalid_argument("Rigid3d: rotation must be a non-zero finite quaternion and "
-                                "translation finite");
+    throw InternalError("Rigid3d: rotation must be a non-zero finite quaternion and translation finite");
   }
   rotation.coeffs() /= norm;
 }
@@ -46,17 +46,24 @@ Rigid3d RelativePose(const Rigid3d& a_from_world, const Rigid3d& b_from_world) {
   return b_from_world * a_from_world.Inverse();
 }
 
+std::string LookAtProblem(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                          const Eigen::Vector3d& world_up) {
+  const Eigen::Vector3d forward = target - eye;
+  if (!(forward.norm() > 0)) return "eye and target coincide";
+  if (!(forward.normalized().cross(world_up).norm() > 1e-12 * world_up.norm())) {
+    return "the viewing direction is parallel to the up vector";
+  }
+  return "";
+}
+
 Rigid3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                const Eigen::Vector3d& world_up) {
-  const Eigen::Vector3d forward = target - eye;
-  if (!(forward.norm() > 0)) throw std::invalid_argument("LookAt: eye and target coincide");
-  const Eigen::Vector3d z = forward.normalized();
-  // Image x = forward x up (right-handed, y down): y = z x x then points away from `up`.
-  const Eigen::Vector3d x_unnormalized = z.cross(world_up);
-  if (!(x_unnormalized.norm() > 1e-12 * world_up.norm())) {
-    throw std::invalid_argument("LookAt: viewing direction is parallel to the up vector");
+  if (std::string problem = LookAtProblem(eye, target, world_up); !problem.empty()) {
+    throw InternalError("LookAt: " + problem);
   }
-  const Eigen::Vector3d x = x_unnormalized.normalized();
+  const Eigen::Vector3d z = (target - eye).normalized();
+  // Image x = forward x up (right-handed, y down): y = z x x then points away from `up`.
+  const Eigen::Vector3d x = z.cross(world_up).normalized();
   const Eigen::Vector3d y = z.cross(x);
   Eigen::Matrix3d cam_from_world_rotation;
   cam_from_world_rotation.row(0) = x;

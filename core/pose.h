@@ -1,6 +1,8 @@
 #pragma once
 // Rigid transforms. A camera pose is `cam_from_world`: x_cam = R * x_world + t, stored as a
 // unit quaternion (w first on disk, as COLMAP writes it) and a translation.
+#include <string>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -11,7 +13,7 @@ struct Rigid3d {
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
 
   Rigid3d() = default;
-  // Normalises `rotation`; throws std::invalid_argument for a zero or non-finite quaternion.
+  // Normalises `rotation`; throws InternalError for a zero or non-finite quaternion.
   Rigid3d(const Eigen::Quaterniond& rotation, const Eigen::Vector3d& translation);
 
   Eigen::Vector3d operator*(const Eigen::Vector3d& point) const {
@@ -31,10 +33,13 @@ Eigen::Vector3d CameraCenter(const Rigid3d& cam_from_world);
 Rigid3d RelativePose(const Rigid3d& a_from_world, const Rigid3d& b_from_world);
 
 // Builds cam_from_world for a camera at `eye` looking at `target`, with image "up" (-y) as
-// close to `world_up` as possible. Throws std::invalid_argument when eye == target or the
-// viewing direction is parallel to world_up.
+// close to `world_up` as possible. Throws InternalError with the LookAtProblem unless it is "".
 Rigid3d LookAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
                const Eigen::Vector3d& world_up);
+// Why LookAt cannot place such a camera (eye and target coincide, or the viewing direction is
+// parallel to world_up), or "" when it can.
+std::string LookAtProblem(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
+                          const Eigen::Vector3d& world_up);
 
 // Shortest-path spherical interpolation, t in [0, 1]. q and -q are the same rotation, so
 // antipodal inputs interpolate over the short arc; nearly equal rotations use normalised

@@ -15,15 +15,6 @@ namespace fs = std::filesystem;
 
 namespace sparse_formats {
 
-bool HasCamera(const SparseModel& model, uint32_t camera_id) {
-  try {
-    model.CameraById(camera_id);
-    return true;
-  } catch (const std::out_of_range&) {
-    return false;
-  }
-}
-
 // COLMAP's "mean observations per image" and "mean track length" header values: both count
 // the 2D points with a 3D point.
 uint64_t NumObservations(const SparseModel& model) {
@@ -61,7 +52,7 @@ std::optional<std::string> FindBrokenReference(const SparseModel& model) {
   for (const Point3D& point : model.Points3D()) points.emplace(point.id, &point);
 
   for (const SparseImage& image : model.Images()) {
-    if (!sparse_formats::HasCamera(model, image.camera_id)) {
+    if (!model.HasCamera(image.camera_id)) {
       return "image " + std::to_string(image.id) + " refers to camera " +
              std::to_string(image.camera_id) + ", which does not exist";
     }
@@ -96,18 +87,12 @@ std::optional<std::string> FindBrokenReference(const SparseModel& model) {
   return std::nullopt;
 }
 
-// Refuses (std::invalid_argument) what the readers would refuse, so a written model can
-// always be read back.
+// Refuses (InternalError) what the readers would refuse, so a written model can always be read
+// back.
 void CheckWritable(const SparseModel& model, SparseFormat format) {
-  auto fail = [](const std::string& what) {
-    throw std::invalid_argument("cannot write sparse model: " + what);
-  };
+  auto fail = [](const std::string& what) { throw InternalError("cannot write sparse model: " + what); };
   for (const Camera& camera : model.Cameras()) {
-    try {
-      camera.Check();
-    } catch (const std::invalid_argument& error) {
-      fail("camera " + std::to_string(camera.id) + ": " + error.what());
-    }
+    if (std::string problem = camera.Problem(); !problem.empty()) fail(problem);
   }
   for (const SparseImage& image : model.Images()) {
     const std::string where = "image " + std::to_string(image.id) + " ";
@@ -139,21 +124,21 @@ void CheckWritable(const SparseModel& model, SparseFormat format) {
 
 void SparseModel::AddCamera(Camera camera) {
   if (!camera_index_.emplace(camera.id, cameras_.size()).second) {
-    throw std::invalid_argument("duplicate camera id " + std::to_string(camera.id));
+    throw InternalError("duplicate camera id " + std::to_string(camera.id));
   }
   cameras_.push_back(std::move(camera));
 }
 
 void SparseModel::AddImage(SparseImage image) {
   if (!image_index_.emplace(image.id, images_.size()).second) {
-    throw std::invalid_argument("duplicate image id " + std::to_string(image.id));
+    throw InternalError("duplicate image id " + std::to_string(image.id));
   }
   images_.push_back(std::move(image));
 }
 
 void SparseModel::AddPoint3D(Point3D point) {
   if (!point3d_index_.emplace(point.id, points3d_.size()).second) {
-    throw std::invalid_argument("duplicate 3D point id " + std::to_string(point.id));
+    throw InternalError("duplicate 3D point id " + std::to_string(point.id));
   }
   points3d_.push_back(std::move(point));
 }

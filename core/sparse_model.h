@@ -56,10 +56,13 @@ enum class SparseFormat { kText, kBinary };
 
 class SparseModel {
  public:
-  // Adding an entry whose id is already present throws std::invalid_argument.
+  // Adding an entry whose id is already present throws InternalError: readers check Has*.
   void AddCamera(Camera camera);
   void AddImage(SparseImage image);
   void AddPoint3D(Point3D point);
+  bool HasCamera(uint32_t id) const { return camera_index_.contains(id); }
+  bool HasImage(uint32_t id) const { return image_index_.contains(id); }
+  bool HasPoint3D(uint64_t id) const { return point3d_index_.contains(id); }
 
   const std::vector<Camera>& Cameras() const { return cameras_; }
   const std::vector<SparseImage>& Images() const { return images_; }
@@ -106,7 +109,8 @@ SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& 
 SparseModel SelectPoints(const SparseModel& model, size_t first, size_t step);
 
 // Writes cameras, images and points3D in `format` into `dir` (created if missing). Each file is
-// written to a temporary name and renamed. Throws BadInputError if `dir` is not writable.
+// written to a temporary name and renamed. Throws BadInputError if `dir` is not writable,
+// InternalError for a model the readers would refuse (a non-finite pose, say).
 void WriteSparseModel(const SparseModel& model, const std::filesystem::path& dir,
                       SparseFormat format);
 

@@ -2,7 +2,6 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
-#include <stdexcept>
 #include <string_view>
 #include <type_traits>
 
@@ -124,21 +123,16 @@ void ReadCamerasBinary(const fs::path& path, SparseModel* model) {
     Camera camera;
     camera.id = reader.Read<uint32_t>();
     const int32_t model_id = reader.Read<int32_t>();
-    try {
-      camera.model = CameraModelFromId(model_id);
-    } catch (const std::invalid_argument&) {
-      reader.Fail("unknown camera model id " + std::to_string(model_id));
-    }
+    const std::optional<CameraModel> camera_model = CameraModelWithId(model_id);
+    if (!camera_model) reader.Fail("unknown camera model id " + std::to_string(model_id));
+    camera.model = *camera_model;
     camera.width = reader.Read<uint64_t>();
     camera.height = reader.Read<uint64_t>();
     camera.params.resize(NumCameraParams(camera.model));
     for (double& param : camera.params) param = reader.Read<double>();
-    try {
-      camera.Check();
-      model->AddCamera(std::move(camera));
-    } catch (const std::invalid_argument& error) {
-      reader.Fail(error.what());
-    }
+    if (std::string problem = camera.Problem(); !problem.empty()) reader.Fail(problem);
+    if (model->HasCamera(camera.id)) reader.Fail("duplicate camera id " + std::to_string(camera.id));
+    model->AddCamera(std::move(camera));
   }
   reader.ExpectEnd();
 }
@@ -161,7 +155,7 @@ void ReadImagesBinary(const fs::path& path, SparseModel* model) {
       image.cam_from_world.translation[k] = reader.ReadFinite(k == 0 ? "TX" : k == 1 ? "TY" : "TZ");
     }
     image.camera_id = reader.Read<uint32_t>();
-    if (!HasCamera(*model, image.camera_id)) {
+    if (!model->HasCamera(image.camera_id)) {
       reader.Fail("camera id " + std::to_string(image.camera_id) + " is not in cameras.bin");
     }
     image.name = reader.ReadNulTerminated();
@@ -172,11 +166,8 @@ void ReadImagesBinary(const fs::path& path, SparseModel* model) {
       point.xy.y() = reader.ReadFinite("2D point y");
       point.point3d_id = reader.Read<uint64_t>();
     }
-    try {
-      model->AddImage(std::move(image));
-    } catch (const std::invalid_argument& error) {
-      reader.Fail(error.what());
-    }
+    if (model->HasImage(image.id)) reader.Fail("duplicate image id " + std::to_string(image.id));
+    model->AddImage(std::move(image));
   }
   reader.ExpectEnd();
 }
@@ -198,11 +189,8 @@ void ReadPoints3DBinary(const fs::path& path, SparseModel* model) {
       element.image_id = reader.Read<uint32_t>();
       element.point2d_idx = reader.Read<uint32_t>();
     }
-    try {
-      model->AddPoint3D(std::move(point));
-    } catch (const std::invalid_argument& error) {
-      reader.Fail(error.what());
-    }
+    if (model->HasPoint3D(point.id)) reader.Fail("duplicate 3D point id " + std::to_string(point.id));
+    model->AddPoint3D(std::move(point));
   }
   reader.ExpectEnd();
 }

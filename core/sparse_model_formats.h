@@ -29,9 +29,6 @@ std::string CamerasText(const SparseModel& model);
 std::string ImagesText(const SparseModel& model);
 std::string Points3DText(const SparseModel& model);
 
-// Whether `model` has a camera with this id.
-bool HasCamera(const SparseModel& model, uint32_t camera_id);
-
 // The number of 2D points with a 3D point (for the text headers' means).
 uint64_t NumObservations(const SparseModel& model);
 

@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <stdexcept>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -125,11 +124,9 @@ void ReadCamerasText(const fs::path& path, SparseModel* model) {
     }
     Camera camera;
     camera.id = ParseInteger<uint32_t>(fields[0], "CAMERA_ID", at);
-    try {
-      camera.model = CameraModelFromName(fields[1]);
-    } catch (const std::invalid_argument&) {
-      at.Fail("unknown camera model '" + std::string(fields[1]) + "'");
-    }
+    const std::optional<CameraModel> camera_model = CameraModelNamed(fields[1]);
+    if (!camera_model) at.Fail("unknown camera model '" + std::string(fields[1]) + "'");
+    camera.model = *camera_model;
     camera.width = ParseInteger<uint64_t>(fields[2], "WIDTH", at);
     camera.height = ParseInteger<uint64_t>(fields[3], "HEIGHT", at);
     const size_t expected = NumCameraParams(camera.model);
@@ -141,12 +138,9 @@ void ReadCamerasText(const fs::path& path, SparseModel* model) {
     for (size_t i = 4; i < fields.size(); ++i) {
       camera.params.push_back(ParseFinite(fields[i], "parameter", at));
     }
-    try {
-      camera.Check();
-      model->AddCamera(std::move(camera));
-    } catch (const std::invalid_argument& error) {
-      at.Fail(error.what());
-    }
+    if (std::string problem = camera.Problem(); !problem.empty()) at.Fail(problem);
+    if (model->HasCamera(camera.id)) at.Fail("duplicate camera id " + std::to_string(camera.id));
+    model->AddCamera(std::move(camera));
   }
 }
 
@@ -172,7 +166,7 @@ void ReadImagesText(const fs::path& path, SparseModel* model) {
         ParseFinite(fields[5], "TX", at), ParseFinite(fields[6], "TY", at),
         ParseFinite(fields[7], "TZ", at));
     image.camera_id = ParseInteger<uint32_t>(fields[8], "CAMERA_ID", at);
-    if (!HasCamera(*model, image.camera_id)) {
+    if (!model->HasCamera(image.camera_id)) {
       at.Fail("camera id " + std::to_string(image.camera_id) + " is not in cameras.txt");
     }
     // The name is the rest of the line, so names with inner spaces survive a round trip
@@ -201,11 +195,8 @@ void ReadImagesText(const fs::path& path, SparseModel* model) {
             id == "-1" ? kInvalidPoint3DId : ParseInteger<uint64_t>(id, "POINT3D_ID", points_at);
       }
     }
-    try {
-      model->AddImage(std::move(image));
-    } catch (const std::invalid_argument& error) {
-      at.Fail(error.what());
-    }
+    if (model->HasImage(image.id)) at.Fail("duplicate image id " + std::to_string(image.id));
+    model->AddImage(std::move(image));
   }
 }
 
@@ -230,11 +221,8 @@ void ReadPoints3DText(const fs::path& path, SparseModel* model) {
       point.track[i].image_id = ParseInteger<uint32_t>(fields[8 + 2 * i], "IMAGE_ID", at);
       point.track[i].point2d_idx = ParseInteger<uint32_t>(fields[9 + 2 * i], "POINT2D_IDX", at);
     }
-    try {
-      model->AddPoint3D(std::move(point));
-    } catch (const std::invalid_argument& error) {
-      at.Fail(error.what());
-    }
+    if (model->HasPoint3D(point.id)) at.Fail("duplicate 3D point id " + std::to_string(point.id));
+    model->AddPoint3D(std::move(point));
   }
 }
 

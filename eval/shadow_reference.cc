@@ -1,7 +1,6 @@
 #include "eval/shadow_reference.h"
 
 #include <cmath>
-#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -13,7 +12,7 @@ namespace parallax {
 std::vector<ReferencePixel> ReferenceShadows(const TriangleMesh& mesh, const ViewCamera& view,
                                              const Eigen::Vector3d& direction) {
   if (!(direction.norm() > 0) || !direction.allFinite()) {
-    throw std::invalid_argument("ReferenceShadows: the light direction must be finite and non-zero");
+    throw InternalError("ReferenceShadows: the light direction must be finite and non-zero");
   }
   const MeshRaycaster raycaster(mesh.vertices, mesh.triangles);
   const std::vector<RayHit> hits = raycaster.CastPixels(view.camera, view.cam_from_world);
@@ -63,7 +62,7 @@ template <typename RenderedShadowedFn, typename OnlyFn>
 MaskComparison CompareMasks(const std::vector<ReferencePixel>& reference, const Image& aux,
                             const RenderedShadowedFn& rendered_shadowed, const OnlyFn& only) {
   if (reference.size() != static_cast<size_t>(aux.Width()) * static_cast<size_t>(aux.Height())) {
-    throw std::invalid_argument("shadow mask comparison: the reference and the frame differ in size");
+    throw InternalError("shadow mask comparison: the reference and the frame differ in size");
   }
   MaskComparison result;
   int intersection = 0, union_count = 0;

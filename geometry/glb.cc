@@ -3,12 +3,12 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -31,20 +31,20 @@ void Pad(std::string* bytes, char fill) {
 }
 
 void CheckMesh(const TriangleMesh& mesh) {
-  if (mesh.triangles.empty()) throw std::invalid_argument("WriteGlb: the mesh has no triangles");
+  if (mesh.triangles.empty()) throw InternalError("WriteGlb: the mesh has no triangles");
   if (mesh.corner_uvs.size() != 3 * mesh.triangles.size()) {
-    throw std::invalid_argument("WriteGlb: " + std::to_string(mesh.corner_uvs.size()) +
-                                " texture coordinates for " + std::to_string(mesh.triangles.size()) +
-                                " triangles, expected 3 per triangle");
+    throw InternalError("WriteGlb: " + std::to_string(mesh.corner_uvs.size()) +
+                        " texture coordinates for " + std::to_string(mesh.triangles.size()) +
+                        " triangles, expected 3 per triangle");
   }
   for (const Eigen::Vector3i& triangle : mesh.triangles) {
     for (int c = 0; c < 3; ++c) {
       if (triangle[c] < 0 || static_cast<size_t>(triangle[c]) >= mesh.vertices.size()) {
-        throw std::invalid_argument("WriteGlb: a triangle refers to vertex " + std::to_string(triangle[c]) +
-                                    " of " + std::to_string(mesh.vertices.size()));
+        throw InternalError("WriteGlb: a triangle refers to vertex " + std::to_string(triangle[c]) +
+                            " of " + std::to_string(mesh.vertices.size()));
       }
       if (!mesh.vertices[static_cast<size_t>(triangle[c])].allFinite()) {
-        throw std::invalid_argument("WriteGlb: vertex " + std::to_string(triangle[c]) + " is not finite");
+        throw InternalError("WriteGlb: vertex " + std::to_string(triangle[c]) + " is not finite");
       }
     }
   }
@@ -109,8 +109,8 @@ void WriteGlb(const std::filesystem::path& path, const TriangleMesh& mesh, std::
   std::string json = Document(corners, low, high, atlas_png.size(), buffer.size()).dump();
   Pad(&json, ' ');
   if (28 + json.size() + buffer.size() > std::numeric_limits<uint32_t>::max()) {
-    throw std::invalid_argument("WriteGlb: " + std::to_string(mesh.triangles.size()) +
-                                " triangles and the atlas exceed the 4 GiB a .glb can hold");
+    throw InternalError("WriteGlb: " + std::to_string(mesh.triangles.size()) +
+                        " triangles and the atlas exceed the 4 GiB a .glb can hold");
   }
   std::string glb;
   glb.reserve(28 + json.size() + buffer.size());

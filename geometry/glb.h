@@ -13,7 +13,7 @@ namespace parallax {
 // coordinate and the atlas gives each triangle corner its own, so every corner is a vertex of
 // its own (no index buffer). The material is unlit (KHR_materials_unlit): the atlas already
 // holds the photos' light. The scene's node turns the mesh half a turn about x, from COLMAP's
-// frame (y down, cameras looking along +z) to glTF's (+y up). Throws std::invalid_argument for
+// frame (y down, cameras looking along +z) to glTF's (+y up). Throws InternalError for
 // a mesh without triangles, without one texture coordinate per corner, or with a non-finite
 // vertex.
 void WriteGlb(const std::filesystem::path& path, const TriangleMesh& mesh, std::string_view atlas_png);

@@ -27,7 +27,7 @@ struct GroundPlaneOptions {
   // Planes whose normal is more than this angle from `up_hint` are not the ground (degrees).
   // Only used when an up hint is given.
   double max_tilt_deg = 45;
-  void Check() const;  // Throws std::invalid_argument naming the field.
+  void Check() const;  // Throws UsageError naming the field.
 };
 
 // Fits the ground plane to `points`. `up_hint` (unit, e.g. the mean "up" of the source cameras)

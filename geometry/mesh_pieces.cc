@@ -1,7 +1,8 @@
 #include "geometry/mesh_pieces.h"
 
 #include <numeric>
-#include <stdexcept>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -40,7 +41,7 @@ std::vector<int> PieceOfEachVertex(const TriangleMesh& mesh, int& piece_count) {
 
 TriangleMesh KeepTriangles(const TriangleMesh& mesh, const std::vector<uint8_t>& keep) {
   if (keep.size() != mesh.triangles.size()) {
-    throw std::invalid_argument("KeepTriangles: one entry per triangle expected");
+    throw InternalError("KeepTriangles: one entry per triangle expected");
   }
   const bool normals = mesh.normals.size() == mesh.vertices.size();
   const bool colors = mesh.colors.size() == mesh.vertices.size();

@@ -14,7 +14,7 @@ std::vector<int> PieceOfEachVertex(const TriangleMesh& mesh, int& piece_count);
 
 // The mesh with only the triangles whose `keep` is nonzero (one entry per triangle), and only
 // the vertices (with their normals and colors) those triangles use, in their first use's order.
-// Texture coordinates and the atlas are not carried. Throws std::invalid_argument when `keep`
+// Texture coordinates and the atlas are not carried. Throws InternalError when `keep`
 // has another size than the triangles.
 TriangleMesh KeepTriangles(const TriangleMesh& mesh, const std::vector<uint8_t>& keep);
 

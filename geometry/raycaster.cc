@@ -1,12 +1,12 @@
 #include "geometry/raycaster.h"
 
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "geometry/embree_scene.h"
 
 namespace parallax {
@@ -44,7 +44,7 @@ RTCRay MakeRay(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, 
 
 std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
                                               const Rigid3d& cam_from_world) const {
-  if (camera.HasDistortion()) throw std::invalid_argument("CastPixels: camera has distortion");
+  if (camera.HasDistortion()) throw InternalError("CastPixels: camera has distortion");
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   std::vector<RayHit> hits(static_cast<size_t>(width) * height);
   const Eigen::Matrix3d world_from_cam = cam_from_world.rotation.conjugate().toRotationMatrix();

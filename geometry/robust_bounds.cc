@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
+
+#include "core/error.h"
 
 namespace parallax {
 
 Eigen::AlignedBox3f RobustBounds(const std::vector<Eigen::Vector3f>& points, float outlier_fraction) {
   if (!(outlier_fraction >= 0 && outlier_fraction < 0.5f)) {
-    throw std::invalid_argument("RobustBounds: outlier_fraction must be in [0, 0.5), got " +
-                                std::to_string(outlier_fraction));
+    throw InternalError("RobustBounds: outlier_fraction must be in [0, 0.5), got " +
+                        std::to_string(outlier_fraction));
   }
   Eigen::AlignedBox3f box;
   if (points.empty()) return box;

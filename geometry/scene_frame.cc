@@ -4,11 +4,11 @@
 #include <cmath>
 #include <numbers>
 #include <random>
-#include <stdexcept>
 #include <tuple>
 
 #include <Eigen/Dense>
 
+#include "core/error.h"
 #include "geometry/robust_bounds.h"
 
 namespace parallax {
@@ -77,7 +77,7 @@ Eigen::Vector3d OpticalAxis(const FrameCamera& camera) {
 // The frame of cameras alone (FitSceneFrame): their centres and the point they look at stand
 // for the scene, which nothing else locates.
 SceneFrame CamerasOnlyFrame(const std::vector<FrameCamera>& cameras) {
-  if (cameras.empty()) throw std::invalid_argument("FitSceneFrame: no triangles, no points and no cameras");
+  if (cameras.empty()) throw InternalError("FitSceneFrame: no triangles, no points and no cameras");
   std::vector<Eigen::Vector3f> stand_ins;
   for (const FrameCamera& camera : cameras) stand_ins.push_back(CameraCenter(camera.cam_from_world).cast<float>());
   if (const std::optional<Eigen::Vector3d> looked_at = LookedAtPoint(cameras)) stand_ins.push_back(looked_at->cast<float>());

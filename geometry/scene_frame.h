@@ -88,7 +88,7 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
 // Without triangles and without points the cameras alone make the frame: the camera centres
 // and their LookedAtPoint (when there is one) stand for the scene, giving bounds, extent and
 // focus; no ground is fitted (a ring of camera centres is a plane, but not the ground); up is
-// the cameras' up, else +z; the rig is fitted as above. Throws std::invalid_argument when
+// the cameras' up, else +z; the rig is fitted as above. Throws InternalError when
 // there are neither triangles, nor points, nor cameras.
 SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& cloud,
                          const std::vector<FrameCamera>& cameras);

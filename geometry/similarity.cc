@@ -5,7 +5,6 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
-#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +13,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include "core/error.h"
 #include "core/statistics.h"
 #include "core/check.h"
 
@@ -55,21 +55,21 @@ bool IsFinitePose(const Rigid3d& pose) {
 void ValidateCameras(const std::vector<Rigid3d>& source_cams,
                      const std::vector<Rigid3d>& target_cams) {
   if (source_cams.size() != target_cams.size()) {
-    throw std::invalid_argument("AlignSimilarity: " + std::to_string(source_cams.size()) +
-                                " source cameras but " + std::to_string(target_cams.size()) +
-                                " target cameras; they must correspond one to one");
+    throw InternalError("AlignSimilarity: " + std::to_string(source_cams.size()) +
+                        " source cameras but " + std::to_string(target_cams.size()) +
+                        " target cameras; they must correspond one to one");
   }
   if (source_cams.size() < 3) {
-    throw std::invalid_argument("AlignSimilarity: need at least 3 cameras, got " +
-                                std::to_string(source_cams.size()));
+    throw InternalError("AlignSimilarity: need at least 3 cameras, got " +
+                        std::to_string(source_cams.size()));
   }
   for (size_t i = 0; i < source_cams.size(); ++i) {
     for (const auto& [cams, frame] :
          {std::pair{&source_cams, "source"}, std::pair{&target_cams, "target"}}) {
       if (!IsFinitePose((*cams)[i])) {
-        throw std::invalid_argument(std::string("AlignSimilarity: ") + frame + " camera " +
-                                    std::to_string(i) +
-                                    " has a non-finite or zero-quaternion pose");
+        throw InternalError(std::string("AlignSimilarity: ") + frame + " camera " +
+                            std::to_string(i) +
+                            " has a non-finite or zero-quaternion pose");
       }
     }
   }
@@ -105,10 +105,10 @@ NormalisedCentres Normalise(const std::vector<Eigen::Vector3d>& centres, const c
   }
   const double largest = *std::max_element(distances.begin(), distances.end());
   if (!(largest > kCoincidentRelative * magnitude)) {
-    throw std::invalid_argument(std::string("AlignSimilarity: the ") + frame +
-                                " camera centres all coincide (largest offset " + Format(largest) +
-                                " at magnitude " + Format(magnitude) +
-                                "), so the scale is undetermined");
+    throw InternalError(std::string("AlignSimilarity: the ") + frame +
+                        " camera centres all coincide (largest offset " + Format(largest) +
+                        " at magnitude " + Format(magnitude) +
+                        "), so the scale is undetermined");
   }
   const double median = Median(distances);
   result.spread = median >= kMinMedianSpreadFraction * largest ? median : largest;

@@ -34,7 +34,7 @@ struct AlignmentOptions {
   double robust_center_fraction = 0.01;
   // Scale of the robust loss on orientation residuals, in degrees.
   double robust_rotation_deg = 1;
-  void Check() const;  // Throws std::invalid_argument naming the field.
+  void Check() const;  // Throws UsageError naming the field.
 };
 
 struct AlignmentResult {
@@ -48,7 +48,7 @@ struct AlignmentResult {
 // stays determined for collinear centres), refined with Ceres over centres and orientations
 // under a robust loss, in normalised coordinates (so scales of 1e-8..1e8 and offsets of 1e6
 // are as well-conditioned as unit ones).
-// Throws std::invalid_argument for different counts, fewer than 3 cameras, or target centres
+// Throws InternalError for different counts, fewer than 3 cameras, or target centres
 // that all coincide (the scale is then undetermined).
 AlignmentResult AlignSimilarity(const std::vector<Rigid3d>& source_cams,
                                 const std::vector<Rigid3d>& target_cams,

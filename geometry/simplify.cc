@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <stdexcept>
 #include <unordered_map>
 #include <unordered_set>
 
 #include <Eigen/Eigenvalues>
 
+#include "core/error.h"
 #include "core/hash.h"
 
 namespace parallax {
@@ -129,10 +129,10 @@ TriangleMesh Cluster(const TriangleMesh& mesh, const ClusterGrid& grid) {
 }  // namespace
 
 TriangleMesh SimplifyMesh(const TriangleMesh& mesh, size_t max_triangles) {
-  if (max_triangles < 1) throw std::invalid_argument("SimplifyMesh: the budget must be at least 1 triangle");
+  if (max_triangles < 1) throw InternalError("SimplifyMesh: the budget must be at least 1 triangle");
   for (const Eigen::Vector3i& t : mesh.triangles) {
     if (t.minCoeff() < 0 || static_cast<size_t>(t.maxCoeff()) >= mesh.vertices.size()) {
-      throw std::invalid_argument("SimplifyMesh: a triangle indexes outside the vertices");
+      throw InternalError("SimplifyMesh: a triangle indexes outside the vertices");
     }
   }
   if (mesh.triangles.size() <= max_triangles) return mesh;

@@ -11,7 +11,7 @@ namespace parallax {
 // representatives (Lindstrom 2000): the vertices in each cell of a uniform grid merge into the
 // point that best fits the planes of their triangles, and triangles whose corners fall into
 // fewer than three distinct cells disappear. The grid is the finest whose result fits the
-// budget. Returns `mesh` unchanged when it already fits. Throws std::invalid_argument for a
+// budget. Returns `mesh` unchanged when it already fits. Throws InternalError for a
 // budget below 1 or triangles indexing outside the vertices.
 TriangleMesh SimplifyMesh(const TriangleMesh& mesh, size_t max_triangles);
 

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 #include <unordered_map>
 
+#include "core/error.h"
 #include "core/hash.h"
 #include "core/check.h"
 #include "geometry/mesh_pieces.h"
@@ -99,7 +99,7 @@ MeshOptions MeshOptionsFor(Quality quality) {
 
 TriangleMesh TrimToData(const TriangleMesh& surface, const std::vector<Eigen::Vector3f>& points,
                         const MeshOptions& options) {
-  if (points.empty()) throw std::invalid_argument("TrimToData: no points to trim to");
+  if (points.empty()) throw InternalError("TrimToData: no points to trim to");
   const float cell = OctreeCell(points, options.poisson_depth);
   const float radius = static_cast<float>(options.max_cells_from_data) * cell;
   return Trim(surface, PointGrid(points, radius), radius);

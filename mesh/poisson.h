@@ -61,7 +61,7 @@ void from_json(const nlohmann::json& json, MeshSummary& mesh);
 // `surface` (Poisson's, of the cloud `points` at options.poisson_depth) without the triangles
 // that have a corner farther than options.max_cells_from_data octree cells from every point,
 // and without the vertices no triangle uses; the octree cell is the points' bounding cube over
-// 2^poisson_depth. Non-finite vertices count as far. Throws std::invalid_argument for no points.
+// 2^poisson_depth. Non-finite vertices count as far. Throws InternalError for no points.
 TriangleMesh TrimToData(const TriangleMesh& surface, const std::vector<Eigen::Vector3f>& points,
                         const MeshOptions& options);
 

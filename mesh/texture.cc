@@ -5,11 +5,11 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "geometry/raycaster.h"
 #include "core/check.h"
 
@@ -235,7 +235,7 @@ Image ColorOf(const TextureView& view) {
   Image color = view.color.Pixels().empty() && view.load_color ? view.load_color() : view.color;
   if (static_cast<uint64_t>(color.Width()) != view.camera.width ||
       static_cast<uint64_t>(color.Height()) != view.camera.height || color.Channels() < 3) {
-    throw std::invalid_argument("texture: a view's photo is not an RGB image of its camera's size");
+    throw InternalError("texture: a view's photo is not an RGB image of its camera's size");
   }
   return color;
 }
@@ -260,7 +260,7 @@ TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          TextureSummary& summary) {
   options.Check();
   for (const TextureView& view : views) {
-    if (view.camera.HasDistortion()) throw std::invalid_argument("texture: views must be distortion-free");
+    if (view.camera.HasDistortion()) throw InternalError("texture: views must be distortion-free");
   }
   // Which triangles rank each photo, with their weights; the ranking itself is freed before the
   // atlas is made.

@@ -50,7 +50,8 @@ struct TextureSummary {
   size_t untextured_triangles = 0;  // No photo sees them: mid-grey.
 };
 
-// Throws std::invalid_argument for invalid options or views (or what load_color throws).
+// Throws UsageError for invalid options, InternalError for invalid views (or what load_color
+// throws).
 TriangleMesh TextureMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles,
                          const std::vector<TextureView>& views, const TextureOptions& options,

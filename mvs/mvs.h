@@ -93,7 +93,7 @@ struct DepthPlan {
   std::vector<ViewPlan> estimated;
 };
 
-// Throws std::invalid_argument for invalid options, BadInputError naming a view of
+// Throws UsageError for invalid options, BadInputError naming a view of
 // options.only_views that the model lacks. Deterministic.
 DepthPlan PlanDepth(const SparseModel& model, const MvsOptions& options);
 

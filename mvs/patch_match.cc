@@ -5,11 +5,11 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
-#include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "core/hash.h"
 #include "core/check.h"
 #include "mvs/stereo_pyramid.h"
@@ -36,13 +36,13 @@ Eigen::Matrix3d Intrinsics(const Camera& camera) {
 
 void CheckPinhole(const Camera& camera, const GrayImage& image) {
   if (camera.model != CameraModel::kPinhole && camera.model != CameraModel::kSimplePinhole) {
-    throw std::invalid_argument("PatchMatchStereo needs undistorted PINHOLE cameras, got " +
-                                std::string(CameraModelName(camera.model)));
+    throw InternalError("PatchMatchStereo needs undistorted PINHOLE cameras, got " +
+                        std::string(CameraModelName(camera.model)));
   }
   if (static_cast<uint64_t>(image.width) != camera.width ||
       static_cast<uint64_t>(image.height) != camera.height ||
       image.values.size() != static_cast<size_t>(image.width) * image.height) {
-    throw std::invalid_argument("PatchMatchStereo: image size does not match its camera");
+    throw InternalError("PatchMatchStereo: image size does not match its camera");
   }
 }
 
@@ -450,8 +450,8 @@ DepthNormalMap PatchMatchStereo(const StereoView& reference,
                                 const PatchMatchOptions& options) {
   options.Check();
   if (sources.empty() || sources.size() > kMaxSources) {
-    throw std::invalid_argument("PatchMatchStereo needs 1 to 16 source views, got " +
-                                std::to_string(sources.size()));
+    throw InternalError("PatchMatchStereo needs 1 to 16 source views, got " +
+                        std::to_string(sources.size()));
   }
   CheckPinhole(reference.camera, reference.image);
   for (const StereoView* source : sources) CheckPinhole(source->camera, source->image);

@@ -61,7 +61,7 @@ struct PatchMatchOptions {
   // Normals more oblique than this to the viewing ray (degrees) are not proposed.
   double max_normal_angle_deg = 87;
   uint32_t seed = 1;
-  void Check() const;  // Throws std::invalid_argument naming the field.
+  void Check() const;  // Throws UsageError naming the field.
 };
 
 struct DepthNormalMap {
@@ -72,7 +72,7 @@ struct DepthNormalMap {
 
 // Estimates depth and normal for every pixel of `reference` from `sources` (at least one).
 // Uses every thread of the calling TBB arena; the result does not depend on the thread count.
-// Throws std::invalid_argument for unsupported cameras or size mismatches.
+// Throws InternalError for unsupported cameras or size mismatches.
 DepthNormalMap PatchMatchStereo(const StereoView& reference,
                                 const std::vector<const StereoView*>& sources,
                                 const PatchMatchOptions& options);

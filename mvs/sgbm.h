@@ -22,7 +22,7 @@ struct SgbmOptions {
   int uniqueness_ratio = 10;
   int speckle_window = 100;
   int speckle_range = 2;
-  void Check() const;  // Throws std::invalid_argument naming the field and its value.
+  void Check() const;  // Throws UsageError naming the field and its value.
 };
 
 struct SgbmViewDepth {

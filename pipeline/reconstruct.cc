@@ -233,19 +233,16 @@ void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, Sta
 
 void ReconstructOptions::Check() const {
   if (!intrinsics.empty() && intrinsics.size() != 1 && intrinsics.size() != 4) {
-    throw std::invalid_argument("intrinsics must be f or fx,fy,cx,cy");
+    throw UsageError("intrinsics must be f or fx,fy,cx,cy");
   }
   for (const double value : intrinsics) {
-    if (!(value > 0) || !std::isfinite(value)) {
-      throw std::invalid_argument("intrinsics must be positive numbers");
-    }
+    if (!(value > 0) || !std::isfinite(value)) throw UsageError("intrinsics must be positive numbers");
   }
   if (!intrinsics.empty() && !known_cameras.empty()) {
-    throw std::invalid_argument("intrinsics and known_cameras exclude each other");
+    throw UsageError("intrinsics and known_cameras exclude each other");
   }
   if (!IsProjectionSupported(camera_model)) {
-    throw std::invalid_argument("camera_model " + std::string(CameraModelName(camera_model)) +
-                                " is not supported");
+    throw UsageError("camera_model " + std::string(CameraModelName(camera_model)) + " is not supported");
   }
   RequireOption(exhaustive_limit >= 2, "ReconstructOptions.exhaustive_limit", exhaustive_limit, ">= 2");
   RequireOption(hierarchical_limit >= 2, "ReconstructOptions.hierarchical_limit", hierarchical_limit, ">= 2");
@@ -267,7 +264,7 @@ void ReconstructOptions::Check() const {
   RequireOption(mvs_max_size == 0 || mvs_max_size >= 64, "ReconstructOptions.mvs_max_size", mvs_max_size,
                 "0 (as quality says) or >= 64");
   if (mvs_scale > 0 && mvs_max_size > 0) {
-    throw std::invalid_argument("mvs_scale and mvs_max_size exclude each other");
+    throw UsageError("mvs_scale and mvs_max_size exclude each other");
   }
   plausibility.Check();
 }

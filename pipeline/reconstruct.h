@@ -116,7 +116,7 @@ struct ReconstructOptions {
   int mvs_max_size = 0;
   // After depth: Poisson mesh, trimmed and textured (the mesh stage, pipeline/dense_stages.h).
   bool build_mesh = true;
-  void Check() const;  // Throws std::invalid_argument naming the field.
+  void Check() const;  // Throws UsageError naming the field.
 };
 
 struct ReconstructSummary {

@@ -6,7 +6,6 @@
 #include <map>
 #include <set>
 #include <sstream>
-#include <stdexcept>
 #include <utility>
 
 #include "core/error.h"
@@ -172,7 +171,7 @@ std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& opt
       text = "retrieval (each image with its " + std::to_string(options.retrieval_images) +
              " most similar in " + TreeText(options) + ")";
       break;
-    case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
+    case MatcherChoice::kAuto: throw InternalError("the automatic matcher is not decided");
   }
   if (options.matcher != MatcherChoice::kAuto) return text;
   if (matcher == MatcherChoice::kExhaustive) {
@@ -297,7 +296,7 @@ double PrincipalPointDeviation(const Camera& camera, const std::vector<SparseMod
 
 PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<SparseModel>& parts,
                                                const ReconstructOptions& options) {
-  if (parts.size() < 2) throw std::invalid_argument("CheckRefinedPrincipalPoint needs two parts or more");
+  if (parts.size() < 2) throw InternalError("CheckRefinedPrincipalPoint needs two parts or more");
   // The camera farthest off-centre, and the one whose offset is least certain, in pixels.
   double worst_offset = 0, offset_px = 0, deviation_px = 0, least_significance = HUGE_VAL;
   for (const Camera& camera : refined.Cameras()) {

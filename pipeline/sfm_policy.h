@@ -84,7 +84,7 @@ double ConsecutiveShare(const std::vector<std::string>& names, const std::vector
 MatcherChoice MatcherForConsecutiveShare(const ReconstructOptions& options, double consecutive_share);
 // report.json's sentence for the matcher that ran (never kAuto), and why when it was chosen
 // automatically; past the exhaustive limit the choice rests on `consecutive_share`, which must
-// then be given. Throws std::invalid_argument for kAuto.
+// then be given. Throws InternalError for kAuto.
 std::string DescribeMatcher(MatcherChoice matcher, const ReconstructOptions& options, int num_images,
                             std::optional<double> consecutive_share);
 // What report.json says of the matcher before matching (a dry run's plan); the matches stage

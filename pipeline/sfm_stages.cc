@@ -4,7 +4,6 @@
 #include <fstream>
 #include <functional>
 #include <optional>
-#include <stdexcept>
 #include <string_view>
 
 #include <tbb/parallel_for.h>
@@ -86,7 +85,7 @@ struct Matching {
         arguments.insert(arguments.end(), {"--VocabTreeMatching.num_images", neighbours,
                                            "--VocabTreeMatching.vocab_tree_path", tree});
         return Run("vocab_tree_matcher", arguments, "matches");
-      case MatcherChoice::kAuto: throw std::invalid_argument("the automatic matcher is not decided");
+      case MatcherChoice::kAuto: throw InternalError("the automatic matcher is not decided");
     }
   }
 

@@ -3,8 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
-#include <stdexcept>
 #include <string>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -38,10 +39,10 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
   const int width = depth.Width();
   const int height = depth.Height();
   if (color.Width() != width || color.Height() != height || color.Channels() != 3) {
-    throw std::invalid_argument("MarkBackground: color " + std::to_string(color.Width()) + "x" +
-                                std::to_string(color.Height()) + "x" +
-                                std::to_string(color.Channels()) + " does not match depth " +
-                                std::to_string(width) + "x" + std::to_string(height) + "x3");
+    throw InternalError("MarkBackground: color " + std::to_string(color.Width()) + "x" +
+                        std::to_string(color.Height()) + "x" +
+                        std::to_string(color.Channels()) + " does not match depth " +
+                        std::to_string(width) + "x" + std::to_string(height) + "x3");
   }
   const size_t count = static_cast<size_t>(width) * static_cast<size_t>(height);
   const float* rgb = color.Pixels().data();
@@ -100,8 +101,8 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
 
 int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step) {
   if (!(max_step > 0)) {
-    throw std::invalid_argument("RemoveDepthSpeckles: max_step " + std::to_string(max_step) +
-                                ": expected > 0");
+    throw InternalError("RemoveDepthSpeckles: max_step " + std::to_string(max_step) +
+                        ": expected > 0");
   }
   const int width = depth->Width(), height = depth->Height();
   float* values = depth->Values().data();
@@ -136,8 +137,8 @@ int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step) {
 
 int ErodeDepthEdges(DepthMap* depth, float max_step, int pixels) {
   if (!(max_step > 0) || pixels < 0) {
-    throw std::invalid_argument("ErodeDepthEdges: max_step " + std::to_string(max_step) +
-                                ", pixels " + std::to_string(pixels) + ": expected > 0 and >= 0");
+    throw InternalError("ErodeDepthEdges: max_step " + std::to_string(max_step) +
+                        ", pixels " + std::to_string(pixels) + ": expected > 0 and >= 0");
   }
   const int width = depth->Width(), height = depth->Height();
   std::vector<float>& values = depth->Values();

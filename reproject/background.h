@@ -20,7 +20,7 @@ namespace parallax {
 // enclosed by valid depth, on textured ground the depth estimate missed, or on smooth ground
 // reaching the border only below the scene, are unknown, not background: they stay holes
 // rather than land at infinity. max_step >= 1 turns the color test off. Returns one byte per pixel, row-major,
-// 1 = background. Throws std::invalid_argument when the sizes differ.
+// 1 = background. Throws InternalError when the sizes differ.
 std::vector<uint8_t> MarkBackground(const DepthMap& depth, const Image& color, float max_step);
 // The same into *background, reusing its memory and that of *stack (scratch for the fill).
 void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
@@ -30,7 +30,7 @@ void MarkBackground(const DepthMap& depth, const Image& color, float max_step,
 // max_step relative depth of each other, of at most max_pixels pixels. Estimated depth maps
 // carry such specks in the sky and along occluding edges; warped, they float in front of the
 // sky and the fill smears them into streaks. Returns how many values were cleared. Throws
-// std::invalid_argument for max_step <= 0.
+// InternalError for max_step <= 0.
 int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step);
 
 // Sets to 0 the pixels of `depth` on the near side of a depth edge: within `pixels` (4-steps)
@@ -39,7 +39,7 @@ int RemoveDepthSpeckles(DepthMap* depth, int max_pixels, float max_step);
 // the near surface (foreground fattening): warped, they draw a halo of the background color
 // around every occluder. Without them the near surface stops a pixel short and the other
 // sources (or the fill) give the background there. Returns how many values were cleared.
-// Throws std::invalid_argument for max_step <= 0 or pixels < 0.
+// Throws InternalError for max_step <= 0 or pixels < 0.
 int ErodeDepthEdges(DepthMap* depth, float max_step, int pixels);
 
 }  // namespace parallax

@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "reproject/simd.h"
 #include "core/check.h"
 
@@ -170,14 +170,14 @@ void BlendOptions::Check() const {
 
 void Blend(std::span<const WarpBuffer> buffers, const BlendOptions& options, BlendResult* out) {
   options.Check();
-  if (buffers.empty()) throw std::invalid_argument("Blend: no warped sources");
+  if (buffers.empty()) throw InternalError("Blend: no warped sources");
   const int width = buffers.front().Width(), height = buffers.front().Height();
   for (const WarpBuffer& buffer : buffers) {
     if (buffer.Width() != width || buffer.Height() != height) {
-      throw std::invalid_argument("Blend: warp buffers of different sizes " +
-                                  std::to_string(width) + "x" + std::to_string(height) +
-                                  " and " + std::to_string(buffer.Width()) + "x" +
-                                  std::to_string(buffer.Height()));
+      throw InternalError("Blend: warp buffers of different sizes " +
+                          std::to_string(width) + "x" + std::to_string(height) +
+                          " and " + std::to_string(buffer.Width()) + "x" +
+                          std::to_string(buffer.Height()));
     }
   }
   // BlendRow writes every pixel: a frame loop's result of the same size is reused as it is,

@@ -24,7 +24,7 @@ struct BlendOptions {
   // [1, 16].
   int min_support = 2;
 
-  void Check() const;  // Throws std::invalid_argument naming the field and value.
+  void Check() const;  // Throws UsageError naming the field and value.
 };
 
 // What landed on a target pixel.
@@ -46,7 +46,7 @@ struct BlendResult {
 // (WarpBuffer::Weight: smaller angle between source and target rays, less stretch -> larger).
 // Background samples are blended only where no surface sample landed. Parallel over rows.
 // Overwrites *out, keeping its memory when large enough (a frame loop reuses one).
-// Throws std::invalid_argument for no buffers or buffers of different sizes.
+// Throws InternalError for no buffers or buffers of different sizes.
 void Blend(std::span<const WarpBuffer> buffers, const BlendOptions& options, BlendResult* out);
 
 }  // namespace parallax

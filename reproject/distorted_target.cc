@@ -4,8 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <stdexcept>
 #include <string>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -34,8 +35,8 @@ Camera PinholeCovering(const Camera& camera) {
     }
   }
   if (!(low.x() < high.x() && low.y() < high.y())) {
-    throw std::invalid_argument("camera " + std::to_string(camera.id) + ": its distortion cannot be inverted anywhere "
-                                "on its image border");
+    throw BadInputError("camera " + std::to_string(camera.id) + ": its distortion cannot be inverted anywhere "
+                        "on its image border");
   }
   const double fx = camera.FocalX(), fy = camera.FocalY();
   // Clamped to twice the image on each side of the principal point's share of it.
@@ -44,8 +45,8 @@ Camera PinholeCovering(const Camera& camera) {
   high.x() = std::min(high.x(), 2 * (width - camera.PrincipalX()) / fx);
   high.y() = std::min(high.y(), 2 * (height - camera.PrincipalY()) / fy);
   if (!(low.x() < high.x() && low.y() < high.y())) {  // A principal point far off the image.
-    throw std::invalid_argument("camera " + std::to_string(camera.id) + ": its principal point lies too far outside "
-                                "its image to render it");
+    throw BadInputError("camera " + std::to_string(camera.id) + ": its principal point lies too far outside "
+                        "its image to render it");
   }
   const double left = std::floor(low.x() * fx), top = std::floor(low.y() * fy);
   const auto pinhole_width = static_cast<uint64_t>(std::ceil(high.x() * fx) - left);

@@ -9,8 +9,9 @@ namespace parallax {
 
 // A distortion-free camera with `camera`'s focal lengths whose image holds the undistorted
 // image of `camera`'s: the bounding box of its undistorted border (at most twice its size on
-// a side, for distortions that fold the corners away). Throws std::invalid_argument when no
-// border pixel can be undistorted.
+// a side, for distortions that fold the corners away). Throws BadInputError (only the camera's
+// values can say) when no border pixel can be undistorted or the principal point lies too far
+// outside the image; the caller that read the camera adds the file's name.
 Camera PinholeCovering(const Camera& camera);
 
 // The camera a target is rendered in: itself without distortion, else PinholeCovering.

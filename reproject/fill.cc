@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/check.h"
+#include "core/error.h"
 #include "reproject/depth_aware_fill.h"
 
 namespace parallax {
@@ -128,21 +128,21 @@ FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillO
   options.Check();
   const Pinhole pinhole = Pinhole::From(camera);
   if (classes.width != blend->color.Width() || classes.height != blend->color.Height()) {
-    throw std::invalid_argument("FillHoles: class map " + std::to_string(classes.width) + "x" +
-                                std::to_string(classes.height) + " does not match the image " +
-                                std::to_string(blend->color.Width()) + "x" +
-                                std::to_string(blend->color.Height()));
+    throw InternalError("FillHoles: class map " + std::to_string(classes.width) + "x" +
+                        std::to_string(classes.height) + " does not match the image " +
+                        std::to_string(blend->color.Width()) + "x" +
+                        std::to_string(blend->color.Height()));
   }
   if (!classes.open_to_sky.empty() && classes.open_to_sky.size() != classes.classes.size()) {
-    throw std::invalid_argument("FillHoles: open_to_sky has " +
-                                std::to_string(classes.open_to_sky.size()) + " entries for " +
-                                std::to_string(classes.classes.size()) + " pixels");
+    throw InternalError("FillHoles: open_to_sky has " +
+                        std::to_string(classes.open_to_sky.size()) + " entries for " +
+                        std::to_string(classes.classes.size()) + " pixels");
   }
   if (pinhole.width != classes.width || pinhole.height != classes.height) {
-    throw std::invalid_argument("FillHoles: camera " + std::to_string(pinhole.width) + "x" +
-                                std::to_string(pinhole.height) + " does not match the image " +
-                                std::to_string(classes.width) + "x" +
-                                std::to_string(classes.height));
+    throw InternalError("FillHoles: camera " + std::to_string(pinhole.width) + "x" +
+                        std::to_string(pinhole.height) + " does not match the image " +
+                        std::to_string(classes.width) + "x" +
+                        std::to_string(classes.height));
   }
   FillSummary summary;
   const ClassCounts counts = CountClasses(classes);

@@ -39,7 +39,7 @@ struct FillOptions {
   // kInpaint: Telea neighbourhood radius in pixels, > 0.
   double inpaint_radius_px = 3;
 
-  void Check() const;  // Throws std::invalid_argument naming the field and value.
+  void Check() const;  // Throws UsageError naming the field and value.
 };
 
 // Whether FillHoles fills a pixel of class `c`: holes, and out-of-view pixels with
@@ -69,8 +69,9 @@ struct FillSummary {
 // comes from a sky model instead: an affine function of the viewing ray through `camera` (the
 // target's), fitted to the pixels where background landed, so sky nothing saw continues the
 // gradient of the sky around it.
-// The sample kinds of `blend` are left as they were. Throws std::invalid_argument for bad
-// options, a non-pinhole camera, or a class map (or its open_to_sky) or camera of another size.
+// The sample kinds of `blend` are left as they were. Throws UsageError for bad
+// options, InternalError for a non-pinhole camera, or a class map (or its open_to_sky) or
+// camera of another size.
 FillSummary FillHoles(const ClassMap& classes, const Camera& camera, const FillOptions& options,
                       BlendResult* blend);
 

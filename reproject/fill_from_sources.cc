@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -62,16 +63,16 @@ struct Lookup {
 
 Lookup MakeLookup(const FillSource& source, size_t index) {
   if (source.color == nullptr || source.depth == nullptr) {
-    throw std::invalid_argument("FillFromSources: source " + std::to_string(index) +
-                                " has no color or depth");
+    throw InternalError("FillFromSources: source " + std::to_string(index) +
+                        " has no color or depth");
   }
   Lookup lookup{Pinhole::From(source.camera.camera), source.camera.cam_from_world.rotation.toRotationMatrix(),
                 source.camera.cam_from_world.translation, {}, &source};
   const int width = lookup.pinhole.width, height = lookup.pinhole.height;
   if (source.color->Width() != width || source.color->Height() != height || source.color->Channels() != 3 ||
       source.depth->Width() != width || source.depth->Height() != height) {
-    throw std::invalid_argument("FillFromSources: source " + std::to_string(index) +
-                                ": color or depth not of its camera's size");
+    throw InternalError("FillFromSources: source " + std::to_string(index) +
+                        ": color or depth not of its camera's size");
   }
   lookup.centre = -(lookup.rotation.transpose() * lookup.translation);
   return lookup;
@@ -83,7 +84,7 @@ FillFromSourcesSummary FillFromSources(const ClassMap& classes, const PosedCamer
                                        std::span<const FillSource> sources, BlendResult* blend) {
   const int width = blend->color.Width(), height = blend->color.Height();
   if (classes.width != width || classes.height != height) {
-    throw std::invalid_argument("FillFromSources: class map of another size than the blend");
+    throw InternalError("FillFromSources: class map of another size than the blend");
   }
   std::vector<Lookup> lookups;
   for (size_t i = 0; i < sources.size(); ++i) lookups.push_back(MakeLookup(sources[i], i));

@@ -32,7 +32,7 @@ struct FillFromSourcesSummary {
 // target's (Unstructured-Lumigraph style); a source that sees something in front of the point,
 // or past it, does not. Where at least one source saw it, the pixel's color is that blend
 // instead of the fill's; its depth and sample kind stay. Parallel over rows.
-// Throws std::invalid_argument for a source without color or depth, or of another size than
+// Throws InternalError for a source without color or depth, or of another size than
 // its camera, or a class map of another size than the blend.
 FillFromSourcesSummary FillFromSources(const ClassMap& classes, const PosedCamera& target,
                                        std::span<const FillSource> sources, BlendResult* blend);

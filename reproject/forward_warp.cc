@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "reproject/background.h"
 #include "reproject/rasterizer.h"
 #include "reproject/row_window.h"
@@ -334,8 +334,8 @@ void ForwardWarpOptions::Check() const {
 
 void WarpBuffer::Reset(int width, int height) {
   if (width < 0 || height < 0) {
-    throw std::invalid_argument("WarpBuffer: negative size " + std::to_string(width) + "x" +
-                                std::to_string(height));
+    throw InternalError("WarpBuffer: negative size " + std::to_string(width) + "x" +
+                        std::to_string(height));
   }
   width_ = width;
   height_ = height;

@@ -65,7 +65,7 @@ struct ForwardWarpOptions {
   // overshoot of K sources.
   double outline_splat_share = 0.6;
 
-  void Check() const;  // Throws std::invalid_argument naming the field and value.
+  void Check() const;  // Throws UsageError naming the field and value.
 };
 
 // A per-pixel array of the warp (see Allocate in forward_warp.cc), freed with std::free.
@@ -153,8 +153,8 @@ class WarpScratch {
 // options' background_max_step) where the options warp background at infinity. With a
 // `gain` (core/color_gains.h), the background is marked on the photo as taken and the color is
 // then corrected by it, so the correction never moves the background. Call again whenever the
-// depth or color changes. Throws std::invalid_argument for a source CheckSourceView refuses or
-// bad options.
+// depth or color changes. Throws InternalError for a source CheckSourceView refuses,
+// UsageError for bad options.
 void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {}, const RgbGain& gain = {1, 1, 1});
 
 // Warps `source` into `target`, overwriting *buffer (resized to the target). Points at or
@@ -165,8 +165,8 @@ void PrepareSource(SourceView* source, const ForwardWarpOptions& options = {}, c
 // `bands` > 1 that many bands of target rows are drawn in parallel (TBB), each walking and
 // projecting the whole source (more work in all, for a warp that runs alone), with the same
 // output bit for bit. Allocation-free with a reused `scratch`. Throws
-// std::invalid_argument for a non-pinhole camera, mismatched sizes (CheckSourceView) or bad
-// options. `scratch` may be null (then the warp allocates its own).
+// InternalError for a non-pinhole camera or mismatched sizes (CheckSourceView), UsageError for
+// bad options. `scratch` may be null (then the warp allocates its own).
 void ForwardWarp(const SourceView& source, const PosedCamera& target,
                  const ForwardWarpOptions& options, WarpBuffer* buffer,
                  WarpScratch* scratch = nullptr, int bands = 1);

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <stdexcept>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "reproject/simd.h"
 #include "core/check.h"
 
@@ -256,7 +256,7 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<PosedCamera>
 namespace {
 
 // Each source's frustum in the target's frame. `*all_depth`: every source has a depth map.
-// Throws std::invalid_argument for a depth map or mask that does not match its camera.
+// Throws InternalError for a depth map or mask that does not match its camera.
 std::vector<SourceFrustum> MakeFrustums(const std::vector<ClassifySource>& sources,
                                         const PosedCamera& target, bool* all_depth) {
   std::vector<SourceFrustum> frustums;
@@ -275,8 +275,8 @@ std::vector<SourceFrustum> MakeFrustums(const std::vector<ClassifySource>& sourc
          source.depth->Height() != frustum.pinhole.height ||
          (source.background != nullptr && !source.background->empty() &&
           source.background->size() != count))) {
-      throw std::invalid_argument("ClassifyPixels: source " + std::to_string(j) +
-                                  ": depth map or background mask does not match its camera");
+      throw InternalError("ClassifyPixels: source " + std::to_string(j) +
+                          ": depth map or background mask does not match its camera");
     }
     if (source.background != nullptr && !source.background->empty()) {
       frustum.background = source.background->data();
@@ -295,10 +295,10 @@ ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySour
   const Pinhole pinhole = Pinhole::From(target.camera);
   const int width = pinhole.width, height = pinhole.height;
   if (blend.color.Width() != width || blend.color.Height() != height) {
-    throw std::invalid_argument("ClassifyPixels: blend " + std::to_string(blend.color.Width()) +
-                                "x" + std::to_string(blend.color.Height()) +
-                                " does not match the target camera " + std::to_string(width) +
-                                "x" + std::to_string(height));
+    throw InternalError("ClassifyPixels: blend " + std::to_string(blend.color.Width()) +
+                        "x" + std::to_string(blend.color.Height()) +
+                        " does not match the target camera " + std::to_string(width) +
+                        "x" + std::to_string(height));
   }
   bool all_depth = false;
   const std::vector<SourceFrustum> frustums = MakeFrustums(sources, target, &all_depth);

@@ -45,7 +45,7 @@ struct HoleOptions {
   // that source by more than this share (or it sees background at infinity); in (0, 1).
   double free_space_tolerance = 0.02;
 
-  void Check() const;  // Throws std::invalid_argument naming the field and value.
+  void Check() const;  // Throws UsageError naming the field and value.
 };
 
 struct ClassMap {
@@ -105,8 +105,8 @@ struct ClassifySource {
 //    looking above the sources sees sky nobody photographed, not a hole);
 //  - else it is a hole: a crack when thin, else a disocclusion; open to the sky unless some
 //    source that contains its direction has depth 0 (not background) there.
-// Throws std::invalid_argument for a non-pinhole camera, a size mismatch between blend and
-// target or between a source's camera and its depth map, or bad options.
+// Throws InternalError for a non-pinhole camera, a size mismatch between blend and
+// target or between a source's camera and its depth map; UsageError for bad options.
 ClassMap ClassifyPixels(const BlendResult& blend, const std::vector<ClassifySource>& sources,
                         const PosedCamera& target, const HoleOptions& options);
 // Frustums only: every ray segment inside some source's frustum is a hole.

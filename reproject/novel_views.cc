@@ -180,7 +180,7 @@ void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
   }
   try {
     RenderedCamera(target.camera);
-  } catch (const std::invalid_argument& error) {
+  } catch (const BadInputError& error) {
     throw BadInputError(where + " cannot be rendered: " + error.what());
   }
 }

@@ -13,6 +13,7 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#include "core/error.h"
 #include "reproject/fill_from_sources.h"
 
 namespace parallax {
@@ -54,10 +55,10 @@ RenderResult Render(const std::vector<const SourceView*>& sources, const TargetC
 void Renderer::Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
                       RenderResult* result) {
   const Clock::time_point start = Clock::now();
-  if (sources.empty()) throw std::invalid_argument("Render: no source views");
+  if (sources.empty()) throw InternalError("Render: no source views");
   for (size_t i = 0; i < sources.size(); ++i) {
     if (sources[i] == nullptr) {
-      throw std::invalid_argument("Render: source " + std::to_string(i) + " is null");
+      throw InternalError("Render: source " + std::to_string(i) + " is null");
     }
     CheckSourceView(*sources[i]);
   }

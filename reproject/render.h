@@ -20,7 +20,7 @@ struct RenderOptions {
   HoleOptions holes;
   FillOptions fill;
 
-  void Check() const;  // Checks every part; throws std::invalid_argument naming the field.
+  void Check() const;  // Checks every part; throws UsageError naming the field.
 };
 
 struct RenderTimings {
@@ -57,7 +57,7 @@ class Renderer {
   // Renders the last Render's target again with `source` added to its sources: only `source`
   // is warped, the others' warps are kept (blending, classification and filling run again).
   // `source` and the last call's sources must outlive the next call. Throws std::logic_error
-  // before any Render, std::invalid_argument like Render for a bad source.
+  // before any Render, InternalError like Render for a bad source.
   void RenderWithOneMore(const SourceView& source, RenderResult* result);
 
   const RenderOptions& Options() const { return options_; }
@@ -86,8 +86,8 @@ class Renderer {
 
 // Renders `target` from `sources` (at least one; each checked with CheckSourceView). Sources
 // are warped in parallel, each into its own buffer; blending, classification and filling are
-// parallel over rows. No per-pixel heap allocation. Throws std::invalid_argument for no
-// sources, a null source, a non-pinhole camera, mismatched sizes or bad options.
+// parallel over rows. No per-pixel heap allocation. Throws InternalError for no
+// sources, a null source, a non-pinhole camera or mismatched sizes, UsageError for bad options.
 RenderResult Render(const std::vector<const SourceView*>& sources, const TargetCamera& target,
                     const RenderOptions& options = {});
 

@@ -14,7 +14,7 @@ std::vector<PosedCamera> ReadPosedCameras(const ViewSetPaths& paths, std::vector
 
 // Every image of the view set with its depth: color converted from the sRGB file to linear
 // RGB (alpha dropped). Throws BadInputError naming the file for a missing or corrupt one,
-// std::invalid_argument when an image, its depth and its camera disagree in size.
+// InternalError when an image, its depth and its camera disagree in size.
 std::vector<SourceView> ReadSourceViews(const ViewSetPaths& paths);
 
 }  // namespace parallax

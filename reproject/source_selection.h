@@ -31,7 +31,7 @@ struct SourceSelectionOptions {
   // of what they hide (SourceSeeingMost, of UnseenPoints); >= 0.
   int hole_sources = 2;
 
-  void Check() const;  // Throws std::invalid_argument naming the field and value.
+  void Check() const;  // Throws UsageError naming the field and value.
 };
 
 struct SourceScore {
@@ -51,8 +51,8 @@ std::vector<SourceScore> ScoreSources(const std::vector<PosedCamera>& sources,
 // the target's); each next one adds the most sum over the target's samples it sees of
 // 1 / (1 + angle / angle_scale_deg) times how differently from the chosen ones it sees them
 // (diversity_angle_deg). Sources with overlap below min_overlap (behind the target's scene,
-// looking elsewhere) are never returned, so fewer may come back. Throws std::invalid_argument for a non-pinhole camera or
-// bad options.
+// looking elsewhere) are never returned, so fewer may come back. Throws InternalError for a non-pinhole camera,
+// UsageError for bad options.
 std::vector<int> SelectSources(const std::vector<PosedCamera>& sources, const PosedCamera& target,
                                const SourceSelectionOptions& options);
 

@@ -2,8 +2,9 @@
 
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <string>
+
+#include "core/error.h"
 
 namespace parallax {
 
@@ -11,14 +12,14 @@ Pinhole Pinhole::From(const Camera& camera) {
   const std::string name = "camera " + std::to_string(camera.id);
   camera.Check();
   if (!IsProjectionSupported(camera.model) || camera.HasDistortion()) {
-    throw std::invalid_argument(name + ": reproject needs an undistorted pinhole camera, got " +
-                                std::string(CameraModelName(camera.model)) +
-                                " with distortion");
+    throw InternalError(name + ": reproject needs an undistorted pinhole camera, got " +
+                        std::string(CameraModelName(camera.model)) +
+                        " with distortion");
   }
   constexpr uint64_t kMaxSide = static_cast<uint64_t>(std::numeric_limits<int>::max() / 4);
   if (camera.width > kMaxSide || camera.height > kMaxSide) {
-    throw std::invalid_argument(name + ": size " + std::to_string(camera.width) + "x" +
-                                std::to_string(camera.height) + " is too large");
+    throw InternalError(name + ": size " + std::to_string(camera.width) + "x" +
+                        std::to_string(camera.height) + " is too large");
   }
   Pinhole pinhole;
   pinhole.width = static_cast<int>(camera.width);
@@ -28,9 +29,9 @@ Pinhole Pinhole::From(const Camera& camera) {
   pinhole.cx = camera.PrincipalX();
   pinhole.cy = camera.PrincipalY();
   if (!(pinhole.fx > 0) || !(pinhole.fy > 0)) {
-    throw std::invalid_argument(name + ": focal length must be positive, got fx " +
-                                std::to_string(pinhole.fx) + ", fy " +
-                                std::to_string(pinhole.fy));
+    throw InternalError(name + ": focal length must be positive, got fx " +
+                        std::to_string(pinhole.fx) + ", fy " +
+                        std::to_string(pinhole.fy));
   }
   return pinhole;
 }
@@ -39,16 +40,16 @@ void CheckSourceView(const SourceView& view) {
   const std::string name = "source view '" + view.name + "'";
   const Pinhole pinhole = Pinhole::From(view.camera);
   if (view.color.Channels() != 3) {
-    throw std::invalid_argument(name + ": color must have 3 channels, got " +
-                                std::to_string(view.color.Channels()));
+    throw InternalError(name + ": color must have 3 channels, got " +
+                        std::to_string(view.color.Channels()));
   }
   const auto size = [](int w, int h) { return std::to_string(w) + "x" + std::to_string(h); };
   if (view.color.Width() != pinhole.width || view.color.Height() != pinhole.height ||
       view.depth.Width() != pinhole.width || view.depth.Height() != pinhole.height) {
-    throw std::invalid_argument(name + ": camera " + size(pinhole.width, pinhole.height) +
-                                ", color " + size(view.color.Width(), view.color.Height()) +
-                                " and depth " + size(view.depth.Width(), view.depth.Height()) +
-                                " must have the same size");
+    throw InternalError(name + ": camera " + size(pinhole.width, pinhole.height) +
+                        ", color " + size(view.color.Width(), view.color.Height()) +
+                        " and depth " + size(view.depth.Width(), view.depth.Height()) +
+                        " must have the same size");
   }
 }
 

@@ -6,7 +6,7 @@
 //    z forward; pixel centres lie at integer + 0.5; depth is z-depth, 0 = no value.
 //  - Cameras are pinhole (PINHOLE or SIMPLE_PINHOLE, or a distortion model whose distortion
 //    parameters are all 0): workspace images are undistorted. Anything else throws
-//    std::invalid_argument; RenderNovelView renders a target with distortion in a pinhole
+//    InternalError; RenderNovelView renders a target with distortion in a pinhole
 //    camera and resamples it (distorted_target.h).
 //  - Colors are linear-light float RGB in memory; callers convert sRGB with core/image.h.
 //  - No NaN or Inf ever leaves a function: divisions are guarded and results checked finite.
@@ -58,7 +58,7 @@ struct Pinhole {
   double cx = 0;
   double cy = 0;
 
-  // Throws std::invalid_argument naming the camera id for distortion, a projection the
+  // Throws InternalError naming the camera id for distortion, a projection the
   // pinhole model cannot express, a size beyond int, or a non-positive focal length.
   static Pinhole From(const Camera& camera);
 
@@ -68,7 +68,7 @@ struct Pinhole {
   }
 };
 
-// Throws std::invalid_argument naming the view when the camera is not pinhole, the color is
+// Throws InternalError naming the view when the camera is not pinhole, the color is
 // not 3-channel, or color, depth and camera sizes differ.
 void CheckSourceView(const SourceView& view);
 

@@ -8,7 +8,6 @@
 #include <numbers>
 #include <numeric>
 #include <optional>
-#include <stdexcept>
 #include <thread>
 #include <unordered_map>
 #include <unordered_set>
@@ -16,6 +15,7 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include "core/error.h"
 #include "core/statistics.h"
 #include "core/check.h"
 
@@ -154,7 +154,7 @@ double SolvedRms(ceres::Problem& problem, size_t residuals) {
 
 double FocalRmsRatio(const SparseModel& model, double factor, int max_points) {
   if (!(factor > 0) || max_points < 1) {
-    throw std::invalid_argument("FocalRmsRatio: factor must be > 0 and max_points >= 1");
+    throw InternalError("FocalRmsRatio: factor must be > 0 and max_points >= 1");
   }
   for (const Camera& camera : model.Cameras()) {
     if (!IsProjectionSupported(camera.model)) return 0;

@@ -1,6 +1,6 @@
 #include "sfm/quality_settings.h"
 
-#include <stdexcept>
+#include "core/error.h"
 
 namespace parallax {
 
@@ -10,7 +10,7 @@ QualitySettings SettingsFor(Quality quality) {
     case Quality::kBalanced: return {2000, 4096, false};
     case Quality::kBest: return {3200, 8192, true};
   }
-  throw std::invalid_argument("unknown quality");
+  throw InternalError("unknown quality");
 }
 
 }  // namespace parallax

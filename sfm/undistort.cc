@@ -1,6 +1,5 @@
 #include "sfm/undistort.h"
 
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -22,17 +21,17 @@ Camera PinholeOf(const Camera& camera) {
 void UndistortPhoto(const Camera& camera, const std::filesystem::path& input,
                     const std::filesystem::path& output) {
   if (!IsProjectionSupported(camera.model)) {
-    throw std::invalid_argument("UndistortPhoto: camera " + std::to_string(camera.id) +
-                                ": projection not supported for its model");
+    throw InternalError("UndistortPhoto: camera " + std::to_string(camera.id) +
+                        ": projection not supported for its model");
   }
   // Unchanged: keeps 16-bit and alpha, and does not apply EXIF orientation (COLMAP does not).
   const cv::Mat photo = cv::imread(input.string(), cv::IMREAD_UNCHANGED);
   if (photo.empty()) throw BadInputError(input.string() + ": cannot read the image");
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   if (photo.cols != width || photo.rows != height) {
-    throw std::invalid_argument(input.string() + ": " + std::to_string(photo.cols) + "x" +
-                                std::to_string(photo.rows) + " pixels, camera " +
-                                std::to_string(width) + "x" + std::to_string(height));
+    throw BadInputError(input.string() + ": " + std::to_string(photo.cols) + "x" +
+                        std::to_string(photo.rows) + " pixels, camera " +
+                        std::to_string(width) + "x" + std::to_string(height));
   }
   const double fx = camera.FocalX(), fy = camera.FocalY();
   const double cx = camera.PrincipalX(), cy = camera.PrincipalY();

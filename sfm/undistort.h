@@ -18,9 +18,9 @@ Camera PinholeOf(const Camera& camera);
 // pixel bilinearly at half-pixel offsets and blurs the photo even when the distortion is a
 // tenth of a pixel (the courtyard's SIMPLE_RADIAL k = -0.0005). Pixels whose distorted
 // position falls outside the photo (the corners, with a pincushion lens: k > 0) repeat its
-// border; COLMAP would crop or rescale instead. Throws BadInputError naming the file
-// when it cannot be read or written, std::invalid_argument for a camera whose projection is
-// not supported or a photo of another size.
+// border; COLMAP would crop or rescale instead. Throws BadInputError naming the file when it
+// cannot be read or written or is not of its camera's size, InternalError for a camera whose
+// projection is not supported.
 void UndistortPhoto(const Camera& camera, const std::filesystem::path& input,
                     const std::filesystem::path& output);
 

@@ -4,13 +4,13 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <stdexcept>
 #include <string>
 
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "core/error.h"
 #include "geometry/embree_scene.h"
 #include "synth/texture.h"
 
@@ -153,7 +153,7 @@ TriangleMesh TessellateObject(const ObjectDesc& object) {
     case ShapeType::kSphere: return TessellateSphere(object);
     case ShapeType::kCylinder: return TessellateCylinder(object);
   }
-  throw std::invalid_argument("unknown shape type");
+  throw InternalError("unknown shape type");
 }
 
 struct RayTracer::Impl {
@@ -327,7 +327,7 @@ void RayTracer::Impl::RenderRow(const Camera& camera, const Rigid3d& cam_from_wo
 
 RenderedView RayTracer::Render(const Camera& camera, const Rigid3d& cam_from_world) const {
   camera.Check();
-  if (camera.HasDistortion()) throw std::invalid_argument("RayTracer renders pinhole cameras");
+  if (camera.HasDistortion()) throw InternalError("RayTracer renders pinhole cameras");
   const int width = static_cast<int>(camera.width);
   const int height = static_cast<int>(camera.height);
   RenderedView view{Image(width, height, 3), DepthMap(width, height), Image(width, height, 3)};

@@ -211,11 +211,8 @@ void ParseRig(const Node& node, const std::string& prefix, std::vector<ViewDesc>
   const std::string rig = node.String("rig", "");
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   auto add = [&](const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
-    try {
-      views.push_back({ViewName(prefix, views.size()), LookAt(eye, target, up)});
-    } catch (const std::invalid_argument& error) {
-      node.Fail(error.what());
-    }
+    if (std::string problem = LookAtProblem(eye, target, up); !problem.empty()) node.Fail(problem);
+    views.push_back({ViewName(prefix, views.size()), LookAt(eye, target, up)});
   };
   if (rig == "poses") {
     const Json& poses = node.Array("poses");

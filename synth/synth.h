@@ -13,7 +13,7 @@ namespace parallax {
 struct SynthOptions {
   // Worker threads; 0 uses every core. The output does not depend on it.
   int num_threads = 0;
-  void Check() const;  // Throws std::invalid_argument naming the field.
+  void Check() const;  // Throws UsageError naming the field.
 };
 
 struct SynthSummary {

@@ -77,7 +77,7 @@ struct FrameSettings {
   float point_size_px = 2;
   bool reverse_z = true;          // Use reverse-Z where glClipControl exists.
   Eigen::Vector3f background{0.32f, 0.36f, 0.42f};  // Linear RGB.
-  void Check() const;             // Throws std::invalid_argument naming the field.
+  void Check() const;             // Throws UsageError naming the field.
 };
 
 // Where the frame is seen from. The camera is used as a pinhole (distortion ignored).

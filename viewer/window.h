@@ -22,7 +22,7 @@ struct WindowOptions {
   double light_azimuth_deg = 45;    // The light's start (LightDirectionFromAngles); the arrows
   double light_elevation_deg = 50;  // move it from there.
   std::filesystem::path screenshot_dir = ".";  // Where the S key writes view-<n>.png.
-  void Check() const;      // Throws std::invalid_argument naming the field.
+  void Check() const;      // Throws UsageError naming the field.
 };
 
 // Runs until the window is closed or Esc is pressed. `start_source` jumps to that source

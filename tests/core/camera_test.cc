@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace parallax {
 namespace {
 
@@ -33,26 +35,29 @@ std::vector<Camera> EveryModel() {
 
 TEST(Camera, NamesAndIdsMatchColmap) {
   EXPECT_EQ(CameraModelName(CameraModel::kSimpleRadial), "SIMPLE_RADIAL");
-  EXPECT_EQ(CameraModelFromName("OPENCV"), CameraModel::kOpenCV);
-  EXPECT_EQ(CameraModelFromId(1), CameraModel::kPinhole);
+  EXPECT_EQ(CameraModelNamed("OPENCV"), CameraModel::kOpenCV);
+  EXPECT_EQ(CameraModelWithId(1), CameraModel::kPinhole);
   EXPECT_EQ(NumCameraParams(CameraModel::kOpenCV), 8);
   EXPECT_EQ(NumCameraParams(CameraModel::kFullOpenCV), 12);
-  EXPECT_THROW(CameraModelFromName("PINHOLE2"), std::invalid_argument);
-  EXPECT_THROW(CameraModelFromId(11), std::invalid_argument);
-  EXPECT_THROW(CameraModelFromId(-1), std::invalid_argument);
+  EXPECT_EQ(CameraModelNamed("PINHOLE2"), std::nullopt);
+  EXPECT_EQ(CameraModelWithId(11), std::nullopt);
+  EXPECT_EQ(CameraModelWithId(-1), std::nullopt);
+  EXPECT_THROW(CameraModelName(static_cast<CameraModel>(11)), InternalError);
 }
 
 TEST(Camera, CheckRejectsWrongParameterCountsAndBadValues) {
   Camera camera = MakeCamera(CameraModel::kPinhole, {500, 500, 320, 240});
+  EXPECT_EQ(camera.Problem(), "");
   camera.params.pop_back();
-  EXPECT_THROW(camera.Check(), std::invalid_argument);
+  EXPECT_EQ(camera.Problem(), "camera 1 (PINHOLE): expected 4 parameters, got 3");
+  EXPECT_THROW(camera.Check(), InternalError);
   camera.params = {500, std::nan(""), 320, 240};
-  EXPECT_THROW(camera.Check(), std::invalid_argument);
+  EXPECT_THROW(camera.Check(), InternalError);
   camera.params = {-5, 500, 320, 240};
-  EXPECT_THROW(camera.Check(), std::invalid_argument);
+  EXPECT_THROW(camera.Check(), InternalError);
   camera.params = {500, 500, 320, 240};
   camera.width = 0;
-  EXPECT_THROW(camera.Check(), std::invalid_argument);
+  EXPECT_THROW(camera.Check(), InternalError);
 }
 
 TEST(Camera, ProjectUnprojectRoundTripsForEveryModel) {

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace parallax {
 namespace {
 
@@ -53,7 +55,7 @@ TEST(ImageMetrics, SsimIsOneForIdenticalAndFallsWithNoise) {
   const double ssim = Ssim(noisy, reference);
   EXPECT_LT(ssim, 0.9);
   EXPECT_GT(ssim, 0.3);
-  EXPECT_THROW(Ssim(Pattern(4, 4), reference), std::invalid_argument);
+  EXPECT_THROW(Ssim(Pattern(4, 4), reference), InternalError);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "tests/random_rotation.h"
 
 namespace parallax {
@@ -25,9 +26,9 @@ TEST(Pose, ConstructorNormalisesAndRejectsZeroQuaternions) {
   const Rigid3d pose(Eigen::Quaterniond(2, 0, 0, 0), Eigen::Vector3d(1, 2, 3));
   EXPECT_DOUBLE_EQ(pose.rotation.norm(), 1.0);
   EXPECT_THROW(Rigid3d(Eigen::Quaterniond(0, 0, 0, 0), Eigen::Vector3d::Zero()),
-               std::invalid_argument);
+               InternalError);
   EXPECT_THROW(Rigid3d(Eigen::Quaterniond(std::nan(""), 0, 0, 0), Eigen::Vector3d::Zero()),
-               std::invalid_argument);
+               InternalError);
 }
 
 TEST(Pose, InverseAndRelativePoseCompose) {
@@ -50,8 +51,8 @@ TEST(Pose, LookAtPointsTheOpticalAxisAtTheTargetWithImageUpAlongWorldUp) {
   // A point above the target appears higher in the image (smaller y, since y points down).
   EXPECT_LT((cam_from_world * (target + Eigen::Vector3d::UnitZ())).y(), 0);
   EXPECT_LT((CameraCenter(cam_from_world) - eye).norm(), 1e-12);
-  EXPECT_THROW(LookAt(eye, eye, Eigen::Vector3d::UnitZ()), std::invalid_argument);
-  EXPECT_THROW(LookAt({0, 0, 5}, {0, 0, 0}, Eigen::Vector3d::UnitZ()), std::invalid_argument);
+  EXPECT_THROW(LookAt(eye, eye, Eigen::Vector3d::UnitZ()), InternalError);
+  EXPECT_THROW(LookAt({0, 0, 5}, {0, 0, 0}, Eigen::Vector3d::UnitZ()), InternalError);
 }
 
 TEST(Pose, SlerpEndpointsAndMidpointAngle) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "geometry/obj.h"
 #include "tests/cli_runner.h"
 #include "tests/temp_dir.h"
@@ -85,14 +86,14 @@ TEST(Glb, MeshesItCannotHoldAreRefused) {
   const TempDir dir;
   TriangleMesh mesh = Square();
   mesh.corner_uvs.pop_back();
-  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), std::invalid_argument);
+  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), InternalError);
   mesh = Square();
   mesh.vertices[3].x() = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), std::invalid_argument);
+  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), InternalError);
   mesh = Square();
   mesh.triangles[1][2] = 4;
-  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), std::invalid_argument);
-  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", TriangleMesh(), ""), std::invalid_argument);
+  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", mesh, ""), InternalError);
+  EXPECT_THROW(WriteGlb(dir.Path() / "a.glb", TriangleMesh(), ""), InternalError);
   EXPECT_FALSE(std::filesystem::exists(dir.Path() / "a.glb"));
 }
 

@@ -2,10 +2,11 @@
 
 #include <cmath>
 #include <numbers>
-#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -81,7 +82,7 @@ TEST(FitSceneFrame, ParallelCamerasFallBackToTheFocusBox) {
   EXPECT_LT((orbit.target - Eigen::Vector3d(4.5, 0, 1.5)).norm(), 1e-5);
   EXPECT_EQ(orbit.elevation_deg, 30);
   EXPECT_GT(orbit.distance, 4.5);
-  EXPECT_THROW(FitSceneFrame({}, {}, {}), std::invalid_argument);
+  EXPECT_THROW(FitSceneFrame({}, {}, {}), InternalError);
 }
 
 TEST(FitSceneFrame, GroundOfACloudGivesUpAndFocus) {

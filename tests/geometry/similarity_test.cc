@@ -6,12 +6,12 @@
 #include <limits>
 #include <numbers>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "tests/random_rotation.h"
 
 namespace parallax {
@@ -146,11 +146,13 @@ void ExpectExactRecovery(const std::vector<Rigid3d>& source_cams, const Similari
   EXPECT_LT(result.final_cost, 1e-12);
 }
 
-void ExpectInvalidArgument(const std::function<void()>& call, const std::string& fragment) {
+// `call` throws an Error whose message contains `fragment`.
+template <typename Error = InternalError>
+void ExpectRefused(const std::function<void()>& call, const std::string& fragment) {
   try {
     call();
-    ADD_FAILURE() << "expected std::invalid_argument mentioning '" << fragment << "'";
-  } catch (const std::invalid_argument& error) {
+    ADD_FAILURE() << "accepted; expected a refusal mentioning '" << fragment << "'";
+  } catch (const Error& error) {
     EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos) << error.what();
   }
 }
@@ -315,14 +317,14 @@ TEST(Similarity3d, TransformPoseMapsEachSourceCameraOntoItsTargetPose) {
 TEST(AlignSimilarity, RejectsFewerThanThreeCameras) {
   std::mt19937 random(13);
   const std::vector<Rigid3d> cams = BoxCameras(2, random);
-  ExpectInvalidArgument([&] { AlignSimilarity(cams, cams); }, "at least 3 cameras");
+  ExpectRefused([&] { AlignSimilarity(cams, cams); }, "at least 3 cameras");
 }
 
 TEST(AlignSimilarity, RejectsMismatchedCounts) {
   std::mt19937 random(14);
   const std::vector<Rigid3d> source_cams = BoxCameras(5, random);
   const std::vector<Rigid3d> target_cams = BoxCameras(4, random);
-  ExpectInvalidArgument([&] { AlignSimilarity(source_cams, target_cams); },
+  ExpectRefused([&] { AlignSimilarity(source_cams, target_cams); },
                         "5 source cameras but 4 target cameras");
 }
 
@@ -331,9 +333,9 @@ TEST(AlignSimilarity, RejectsTargetCentresThatAllCoincide) {
   const std::vector<Rigid3d> source_cams = BoxCameras(5, random);
   std::vector<Rigid3d> target_cams;
   for (int i = 0; i < 5; ++i) target_cams.push_back(CameraAt(RandomRotation(random), {1e3, 2, 3}));
-  ExpectInvalidArgument([&] { AlignSimilarity(source_cams, target_cams); },
+  ExpectRefused([&] { AlignSimilarity(source_cams, target_cams); },
                         "target camera centres all coincide");
-  ExpectInvalidArgument([&] { AlignSimilarity(target_cams, source_cams); },
+  ExpectRefused([&] { AlignSimilarity(target_cams, source_cams); },
                         "source camera centres all coincide");
 }
 
@@ -342,29 +344,29 @@ TEST(AlignSimilarity, RejectsNonFinitePoses) {
   const std::vector<Rigid3d> source_cams = BoxCameras(5, random);
   std::vector<Rigid3d> target_cams = source_cams;
   target_cams[3].translation.y() = std::numeric_limits<double>::quiet_NaN();
-  ExpectInvalidArgument([&] { AlignSimilarity(source_cams, target_cams); }, "target camera 3");
+  ExpectRefused([&] { AlignSimilarity(source_cams, target_cams); }, "target camera 3");
   target_cams[3] = source_cams[3];
   target_cams[1].rotation.w() = std::numeric_limits<double>::infinity();
-  ExpectInvalidArgument([&] { AlignSimilarity(target_cams, source_cams); }, "source camera 1");
+  ExpectRefused([&] { AlignSimilarity(target_cams, source_cams); }, "source camera 1");
 }
 
 TEST(AlignmentOptions, CheckRejectsNonPositiveOrNonFiniteFields) {
   EXPECT_NO_THROW(AlignmentOptions().Check());
   AlignmentOptions options;
   options.inlier_center_fraction = 0;
-  ExpectInvalidArgument([&] { options.Check(); }, "inlier_center_fraction");
+  ExpectRefused<UsageError>([&] { options.Check(); }, "inlier_center_fraction");
   options = {};
   options.inlier_rotation_deg = -1;
-  ExpectInvalidArgument([&] { options.Check(); }, "inlier_rotation_deg");
+  ExpectRefused<UsageError>([&] { options.Check(); }, "inlier_rotation_deg");
   options = {};
   options.robust_center_fraction = std::numeric_limits<double>::quiet_NaN();
-  ExpectInvalidArgument([&] { options.Check(); }, "robust_center_fraction");
+  ExpectRefused<UsageError>([&] { options.Check(); }, "robust_center_fraction");
   options = {};
   options.robust_rotation_deg = std::numeric_limits<double>::infinity();
-  ExpectInvalidArgument([&] { options.Check(); }, "robust_rotation_deg");
+  ExpectRefused<UsageError>([&] { options.Check(); }, "robust_rotation_deg");
   std::mt19937 random(17);
   const std::vector<Rigid3d> cams = BoxCameras(4, random);
-  ExpectInvalidArgument([&] { AlignSimilarity(cams, cams, options); }, "robust_rotation_deg");
+  ExpectRefused<UsageError>([&] { AlignSimilarity(cams, cams, options); }, "robust_rotation_deg");
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
+
 namespace parallax {
 namespace {
 
@@ -80,10 +82,10 @@ TEST(SimplifyMesh, MeshWithinBudgetIsReturnedUnchangedAndBadInputIsRefused) {
   const TriangleMesh same = SimplifyMesh(grid, grid.triangles.size());
   EXPECT_EQ(same.triangles, grid.triangles);
   EXPECT_EQ(same.vertices, grid.vertices);
-  EXPECT_THROW(SimplifyMesh(grid, 0), std::invalid_argument);
+  EXPECT_THROW(SimplifyMesh(grid, 0), InternalError);
   TriangleMesh broken = grid;
   broken.triangles.back()[2] = static_cast<int>(grid.vertices.size());
-  EXPECT_THROW(SimplifyMesh(broken, 1), std::invalid_argument);
+  EXPECT_THROW(SimplifyMesh(broken, 1), InternalError);
 }
 
 }  // namespace

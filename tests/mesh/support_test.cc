@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/sparse_model.h"
 #include "geometry/mesh_pieces.h"
 
@@ -66,7 +67,7 @@ TEST(MeshPieces, KeptTrianglesTakeOnlyTheirVertices) {
   ASSERT_EQ(kept.vertices.size(), 9u);
   EXPECT_EQ(kept.normals.size(), 9u);
   for (const Eigen::Vector3f& v : kept.vertices) EXPECT_GE(v.x(), 3);
-  EXPECT_THROW(KeepTriangles(mesh, std::vector<uint8_t>(3, 1)), std::invalid_argument);
+  EXPECT_THROW(KeepTriangles(mesh, std::vector<uint8_t>(3, 1)), InternalError);
 }
 
 TEST(Support, FloatersInSeenFreeSpaceOrSeenByOneViewGoAndTheWallStays) {
@@ -115,10 +116,10 @@ TEST(Support, APieceHalfInFreeSpaceIsSupportedOnlyWhereMoreOfItLiesOnTheSurface)
 TEST(Support, OptionsOutOfRangeAreRefused) {
   SupportOptions options;
   options.depth_tolerance = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
   options = SupportOptions{};
   options.min_views = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 
 #include <optional>
 #include <set>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -72,7 +71,7 @@ TEST(MatcherForConsecutiveShare, AnOrderedCaptureFromTheOrderedShareOnIsMatchedS
             "retrieval (each image with its 40 most similar in a vocabulary tree built from these photos), "
             "chosen automatically: 100 images, more than 75 for exhaustive matching, and 60% of the photos "
             "consecutive in name order match the next (not an ordered capture)");
-  EXPECT_THROW(DescribeMatcher(MatcherChoice::kAuto, options, 100, 0.6), std::invalid_argument);
+  EXPECT_THROW(DescribeMatcher(MatcherChoice::kAuto, options, 100, 0.6), InternalError);
 }
 
 TEST(PlanByCount, TheAutomaticMapperTurnsHierarchicalPastTheLimitOnly) {
@@ -253,7 +252,7 @@ TEST(CheckRefinedPrincipalPoint, APointThePartsDisagreeOnStaysAtTheCentre) {
   EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), PartsAt(529, 23, 250), options).keep);
   EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), PartsAt(529, 24, 250), options).keep);
   EXPECT_THROW(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {OneCameraAt(529, 250)}, options),
-               std::invalid_argument);
+               InternalError);
 }
 
 TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitStaysAtTheCentre) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "core/depth_map.h"
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -49,7 +50,7 @@ TEST(MarkBackground, TexturedPixelsAndGroundWithoutDepthAreUnknown) {
   const std::vector<uint8_t> untested = MarkBackground(depth, color, 1.0f);
   EXPECT_EQ(untested[0 * 8 + 5], 1);
   EXPECT_EQ(untested[5 * 8 + 1], 0);
-  EXPECT_THROW(MarkBackground(depth, Image(7, 6, 3), 0.05f), std::invalid_argument);
+  EXPECT_THROW(MarkBackground(depth, Image(7, 6, 3), 0.05f), InternalError);
 }
 
 // A wall with a 5-pixel speck in front of it and a lone pixel in the sky: both cleared; the
@@ -72,7 +73,7 @@ TEST(RemoveDepthSpeckles, ClearsSmallPatchesOnly) {
   DepthMap strict = cleaned;
   EXPECT_EQ(RemoveDepthSpeckles(&strict, 8, 0.01f), 0);
   EXPECT_EQ(RemoveDepthSpeckles(&strict, 20, 0.01f), 40 * 20 - 5);
-  EXPECT_THROW(RemoveDepthSpeckles(&strict, 10, 0), std::invalid_argument);
+  EXPECT_THROW(RemoveDepthSpeckles(&strict, 10, 0), InternalError);
 }
 
 // A box (depth 4) in front of a wall (depth 8), on a 20x10 map: two pixels of the box along
@@ -102,7 +103,7 @@ TEST(ErodeDepthEdges, ClearsTheNearSideOfEdgesOnly) {
     for (int x = 0; x < 20; ++x) slope.At(x, y) = 5.0f * std::pow(1.03f, static_cast<float>(x));
   }
   EXPECT_EQ(ErodeDepthEdges(&slope, 0.05f, 2), 0);
-  EXPECT_THROW(ErodeDepthEdges(&slope, 0, 2), std::invalid_argument);
+  EXPECT_THROW(ErodeDepthEdges(&slope, 0, 2), InternalError);
 }
 
 // Sky color encodes the world direction, so a warped sky pixel tells where it came from.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "tests/reproject/analytic_scene.h"
 
 namespace parallax {
@@ -96,7 +97,7 @@ TEST(FillFromSources, RefusesASourceWithoutDepth) {
   Case c;
   const FillSource source{c.source_camera, &c.color, nullptr, &c.sky};
   EXPECT_THROW(FillFromSources(c.classes, c.target, std::span<const FillSource>(&source, 1), &c.blend),
-               std::invalid_argument);
+               InternalError);
 }
 
 }  // namespace

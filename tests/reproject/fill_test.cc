@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "reproject/forward_warp.h"
 #include "reproject/render.h"
 #include "tests/reproject/analytic_scene.h"
@@ -180,7 +181,7 @@ TEST(FillHoles, HoleOpenToTheSkyTakesItWhereHalfItsDirectionsFindIt) {
   }
   FillOptions options;
   options.hole_sky_share = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
 }
 
 // Sky in the top rows of the right half, a grey wall (depth 5) below it, and the left half out

@@ -5,12 +5,12 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <stdexcept>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "reproject/background.h"
 #include "reproject/render.h"
 #include "tests/reproject/analytic_scene.h"
@@ -132,7 +132,7 @@ TEST(ForwardWarp, SilhouetteSamplesWeighLess) {
   }
   ForwardWarpOptions options;
   options.silhouette_angle_rad = -0.1;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
 }
 
 // The box's front face (z 4) spans source columns 61.25..98.75 and rows 45..75 (pixel
@@ -171,9 +171,9 @@ TEST(ForwardWarp, OutlineSamplesSplatAShareOfTheirFootprint) {
   EXPECT_EQ(front_face_pixels(1.0), 39 * 30);
   ForwardWarpOptions options;
   options.outline_splat_share = 0;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
   options.outline_splat_share = 1.5;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
 }
 
 // A pole one source column wide (x 0.01..0.03 at z 4: only column 80's centre, 80.5, lies on
@@ -465,12 +465,12 @@ TEST(ForwardWarp, RejectsDistortedCamerasAndBadOptions) {
   source.camera.params = {150, 80, 60, 0.1};
   WarpBuffer buffer;
   EXPECT_THROW(ForwardWarp(source, CameraAt(TestCamera(), {0, 0, 0}), {}, &buffer),
-               std::invalid_argument);
+               InternalError);
   ForwardWarpOptions options;
   options.max_slant_deg = 90;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
   source.camera = TestCamera(100, 120);
-  EXPECT_THROW(CheckSourceView(source), std::invalid_argument);
+  EXPECT_THROW(CheckSourceView(source), InternalError);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "reproject/novel_views.h"
 #include "reproject/source_selection.h"
 #include "tests/reproject/analytic_scene.h"
@@ -440,14 +441,14 @@ TEST(Render, RejectsBadInput) {
   const Scene scene = BoxScene();
   const SourceView source = test::RenderView(scene, CameraAt(BoxCamera(), {0, 0, 0}));
   const PosedCamera target = CameraAt(BoxCamera(), {0, 0, 0});
-  EXPECT_THROW(Render({}, target), std::invalid_argument);
-  EXPECT_THROW(Render({nullptr}, target), std::invalid_argument);
+  EXPECT_THROW(Render({}, target), InternalError);
+  EXPECT_THROW(Render({nullptr}, target), InternalError);
   RenderOptions options;
   options.holes.crack_opening_px = 2;
-  EXPECT_THROW(Render({&source}, target, options), std::invalid_argument);
+  EXPECT_THROW(Render({&source}, target, options), UsageError);
   PosedCamera distorted = target;
   distorted.camera = Camera{1, CameraModel::kOpenCV, 400, 300, {400, 400, 200, 150, 0.1, 0, 0, 0}};
-  EXPECT_THROW(Render({&source}, distorted), std::invalid_argument);
+  EXPECT_THROW(Render({&source}, distorted), InternalError);
 }
 
 }  // namespace

@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <numbers>
-#include <stdexcept>
 
 #include <gtest/gtest.h>
+
+#include "core/error.h"
 
 namespace parallax {
 namespace {
@@ -52,13 +53,13 @@ TEST(SelectSources, DiversityPrefersANewDirectionOverANearDuplicate) {
   options.diversity_angle_deg = 10;
   EXPECT_EQ(SelectSources(sources, RingCamera(0), options), std::vector<int>({0, 2}));
   options.diversity_angle_deg = -1;
-  EXPECT_THROW(options.Check(), std::invalid_argument);
+  EXPECT_THROW(options.Check(), UsageError);
 }
 
 TEST(SelectSources, RejectsBadOptions) {
   SourceSelectionOptions options;
   options.num_sources = 0;
-  EXPECT_THROW(SelectSources({RingCamera(0)}, RingCamera(10), options), std::invalid_argument);
+  EXPECT_THROW(SelectSources({RingCamera(0)}, RingCamera(10), options), UsageError);
 }
 
 }  // namespace

@@ -109,7 +109,7 @@ TEST(ColorGains, FileRoundTripsAndRejectsBadGains) {
   WriteColorGains(dir.Path() / "gains.json", gains);
   EXPECT_EQ(ReadColorGains(dir.Path() / "gains.json").Of("a.jpg"), (RgbGain{1.25f, 0.5f, 2}));
   gains.by_photo["b.jpg"] = {1, -1, 1};
-  EXPECT_THROW(WriteColorGains(dir.Path() / "bad.json", gains), std::invalid_argument);
+  EXPECT_THROW(WriteColorGains(dir.Path() / "bad.json", gains), InternalError);
   std::ofstream(dir.Path() / "nan.json") << R"({"photos": {"a.jpg": [1, 0, 1]}})";
   EXPECT_THROW(ReadColorGains(dir.Path() / "nan.json"), BadInputError);
 }

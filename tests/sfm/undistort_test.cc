@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "core/image.h"
 #include "tests/temp_dir.h"
 
@@ -93,7 +94,7 @@ TEST(UndistortPhoto, BadInputIsNamed) {
   }
   WriteImage(dir.Path() / "small.png", Image(10, 10, 3), PixelFormat::kUint8);
   EXPECT_THROW(UndistortPhoto(SimpleRadial(0.01), dir.Path() / "small.png", dir.Path() / "o.png"),
-               std::invalid_argument);
+               BadInputError);
 }
 
 }  // namespace

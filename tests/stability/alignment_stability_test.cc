@@ -7,12 +7,12 @@
 #include <functional>
 #include <numbers>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "core/error.h"
 #include "tests/random_rotation.h"
 
 #include "geometry/similarity.h"
@@ -45,12 +45,12 @@ std::vector<Rigid3d> Transform(const Similarity3d& similarity, const std::vector
   return moved;
 }
 
-// The refusal must be an std::invalid_argument whose message contains `fragment`.
+// The refusal must be an InternalError whose message contains `fragment`.
 void ExpectRefused(const std::function<void()>& call, const std::string& fragment) {
   try {
     call();
     ADD_FAILURE() << "accepted; expected a refusal mentioning '" << fragment << "'";
-  } catch (const std::invalid_argument& error) {
+  } catch (const InternalError& error) {
     EXPECT_NE(std::string(error.what()).find(fragment), std::string::npos) << error.what();
   }
 }
@@ -139,7 +139,7 @@ TEST(AlignmentStability, NearlyCoincidentCentresAreRefusedOrAlignedCorrectly) {
       EXPECT_LT(error, allowed);
       // The orientations are exact; the centres pull the rotation by at most their error.
       EXPECT_LT(rotation_deg, allowed * 180 / std::numbers::pi);
-    } catch (const std::invalid_argument& error) {
+    } catch (const InternalError& error) {
       EXPECT_NE(std::string(error.what()).find("coincide"), std::string::npos) << error.what();
     }
   }

@@ -149,7 +149,7 @@ TEST(ViewerScene, RobustBoundsIgnoreOnePercentOfFarOutliers) {
   EXPECT_TRUE(RobustBounds({}).isEmpty());
   const Eigen::AlignedBox3f exact = RobustBounds(points, 0);
   EXPECT_FLOAT_EQ(exact.max().z(), 900);
-  EXPECT_THROW(RobustBounds(points, 0.5f), std::invalid_argument);
+  EXPECT_THROW(RobustBounds(points, 0.5f), InternalError);
 }
 
 // A fused cloud of a 20 x 20 courtyard with a block on it, plus 0.5% of points strewn up to
