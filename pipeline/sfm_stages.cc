@@ -15,8 +15,9 @@
 #include "core/interrupt.h"
 #include "core/hash.h"
 #include "pipeline/key_photos.h"
+#include "pipeline/raw_model_workspace.h"
+#include "pipeline/undistort_workspace.h"
 #include "sfm/photo_conversion.h"
-#include "sfm/undistort.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -440,10 +441,10 @@ Stage UndistortStage(const SfmContext& sfm, const std::string& mapper_key,
     const Workspace undistorted(output);
     if (supported) {
       // The held-out photos' cameras beside, without the points (evaluate renders them).
-      WritePinholeWorkspace(SelectImages(*raw_model, sfm.held_out, false), sfm.photos_dir, output);
+      WritePinholeWorkspace(SelectImages(*raw_model, sfm.held_out, false), sfm.photos_dir, undistorted);
       if (!sfm.held_out.empty()) {
         WritePinholeWorkspace(CamerasAndPoses(SelectImages(*raw_model, sfm.held_out, true)), sfm.photos_dir,
-                              undistorted.HeldOut().Root());
+                              undistorted.HeldOut());
         RemoveAll(undistorted.HeldOut().Stereo());
       }
     } else {

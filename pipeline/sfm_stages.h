@@ -2,7 +2,7 @@
 // The structure-from-motion stages of `reconstruct` as data (pipeline/stage_graph.h):
 // features, matches, mapper (or triangulate, with known cameras) and undistort, each keyed by
 // the one before it. Their decisions are pipeline/sfm_policy.h's; the colmap commands on the
-// mapper's models are colmap/raw_model.h's.
+// mapper's models are pipeline/raw_model_workspace.h's.
 #include <filesystem>
 #include <set>
 #include <string>

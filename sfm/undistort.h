@@ -3,7 +3,6 @@
 #include <filesystem>
 
 #include "core/camera.h"
-#include "core/sparse_model.h"
 
 namespace parallax {
 
@@ -23,14 +22,5 @@ Camera PinholeOf(const Camera& camera);
 // projection is not supported.
 void UndistortPhoto(const Camera& camera, const std::filesystem::path& input,
                     const std::filesystem::path& output);
-
-// Writes what `colmap image_undistorter --output_type COLMAP` writes: the photos undistorted into
-// PINHOLE cameras of the same size and intrinsics (copied as they are where a camera has no
-// distortion; UndistortPhoto says why not COLMAP's resampling), the model with those cameras,
-// and the stereo/ folder layout with the configuration files COLMAP's dense tools read, into
-// `output`, laid out as a workspace (core/workspace.h). Throws BadInputError naming a
-// photo that cannot be read or a file that cannot be written.
-void WritePinholeWorkspace(const SparseModel& model, const std::filesystem::path& photos_dir,
-                           const std::filesystem::path& output);
 
 }  // namespace parallax
