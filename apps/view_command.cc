@@ -9,6 +9,7 @@
 
 #include "apps/commands.h"
 #include "apps/number_list.h"
+#include "apps/viewer_paths.h"
 #include "core/workspace_lock.h"
 #include "eval/shadow_reference.h"
 #include "viewer/screenshot.h"
@@ -182,7 +183,7 @@ void RegisterViewCommand(CLI::App& app) {
   command->callback([a] {
     const ViewerScene scene = [&] {
       const WorkspaceLock lock(a->workspace, LockMode::kShared, "view");  // While it reads.
-      return LoadViewerScene(a->workspace);
+      return LoadViewerScene(ViewerScenePathsFor(a->workspace));
     }();
     const FrameSettings settings = Settings(*a, scene);
     if (!a->screenshot.empty()) {

@@ -56,9 +56,12 @@ void ApplyGain(const RgbGain& gain, Image& linear) {
   }
 }
 
+ColorGains ReadColorGainsIfPresent(const std::filesystem::path& file) {
+  return !file.empty() && std::filesystem::exists(file) ? ReadColorGains(file) : ColorGains{};
+}
+
 ColorGains ReadWorkspaceColorGains(const std::filesystem::path& workspace) {
-  const std::filesystem::path path = Workspace(workspace).ColorGainsFile();
-  return std::filesystem::exists(path) ? ReadColorGains(path) : ColorGains{};
+  return ReadColorGainsIfPresent(Workspace(workspace).ColorGainsFile());
 }
 
 }  // namespace parallax

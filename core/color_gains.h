@@ -29,8 +29,11 @@ void WriteColorGains(const std::filesystem::path& path, const ColorGains& gains)
 // Multiplies each pixel's first three channels (linear light) by `gain`.
 void ApplyGain(const RgbGain& gain, Image& linear);
 
-// The gains of a workspace's photos (<ws>/color_gains.json); none when it has no such file
-// (made before gains were estimated).
+// The gains in `file`; none when `file` is empty or names no file (a workspace made before
+// gains were estimated, a scene folder).
+ColorGains ReadColorGainsIfPresent(const std::filesystem::path& file);
+
+// The gains of a workspace's photos (<ws>/color_gains.json), as ReadColorGainsIfPresent.
 ColorGains ReadWorkspaceColorGains(const std::filesystem::path& workspace);
 
 }  // namespace parallax

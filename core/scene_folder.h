@@ -19,6 +19,13 @@ struct ViewSetPaths {
   std::filesystem::path NormalFor(const std::string& image_name) const;
 };
 
+// The files a scene's geometry is read from (ReadSceneGeometry, geometry/scene_frame.h): a mesh
+// (OBJ, with its material) and a cloud (PLY). A path that names no file stands for none.
+struct SceneFiles {
+  std::filesystem::path mesh;
+  std::filesystem::path cloud;
+};
+
 struct SceneFolder {
   std::filesystem::path root;
 

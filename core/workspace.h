@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <string>
 
+#include "core/scene_folder.h"
+
 namespace parallax {
 
 // What a COLMAP dense map was computed from: photometric consistency only, or also the
@@ -79,6 +81,10 @@ class Workspace {
   std::filesystem::path MeshSummary() const { return MeshDir() / "summary.json"; }
   std::filesystem::path DisplayMeshDir() const { return root_ / "mesh_display"; }
   std::filesystem::path DisplayMesh() const { return DisplayMeshDir() / "mesh.obj"; }
+  // The mesh and the cloud the scene frame is fitted to and `view` shows.
+  SceneFiles Geometry() const { return {Mesh(), Fused()}; }
+  // The source views: the undistorted photos, their cameras, depth maps and color gains.
+  ViewSetPaths Sources() const;
 
   std::filesystem::path Logs() const { return root_ / "logs"; }
   std::filesystem::path Log(const std::string& stage) const { return Logs() / (stage + ".log"); }
@@ -91,5 +97,10 @@ class Workspace {
  private:
   std::filesystem::path root_;
 };
+
+// The source views of a workspace (<ws>/sparse, images, depth and color gains; depth maps may
+// still be missing) or of a scene folder (its training set). Throws BadInputError naming the
+// folder when it is neither.
+ViewSetPaths SourcePathsFor(const std::filesystem::path& workspace_or_scene);
 
 }  // namespace parallax

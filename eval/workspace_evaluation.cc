@@ -94,7 +94,7 @@ void RenderAndCompare(const Workspace& workspace, ViewSetPaths sources, const st
   SourceLibrary library(sources);
   library.DropViewsWithoutDepth();  // Views the depth stage could not estimate.
   if (!options.gt_sources) {
-    evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Root(), options.novel, &library).note;
+    evaluation.depth_holes_note = PrepareWorkspaceDepth(workspace.Mesh(), options.novel, &library).note;
   }
   evaluation.comparison_dir = EvaluationLayout(workspace.Root()).NovelComparisons(options.gt_sources);
   evaluation.result = EvaluateNovelViews(library, targets, names, truth, options.novel.selection,

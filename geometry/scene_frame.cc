@@ -9,6 +9,8 @@
 #include <Eigen/Dense>
 
 #include "core/error.h"
+#include "geometry/obj.h"
+#include "geometry/ply.h"
 #include "geometry/robust_bounds.h"
 
 namespace parallax {
@@ -203,6 +205,13 @@ SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vect
   frame.extent.extend(frame.focus);
   frame.rig = FitCameraRig(cameras, frame.up, frame.extent);
   return frame;
+}
+
+SceneGeometry ReadSceneGeometry(const SceneFiles& files) {
+  SceneGeometry geometry;
+  if (std::filesystem::exists(files.mesh)) geometry.mesh = ReadTexturedMesh(files.mesh);
+  if (std::filesystem::exists(files.cloud)) geometry.cloud = ReadPly(files.cloud);
+  return geometry;
 }
 
 std::pair<Eigen::Vector3d, Eigen::Vector3d> GroundAxes(const Eigen::Vector3d& up) {

@@ -16,6 +16,7 @@
 
 #include "core/camera.h"
 #include "core/pose.h"
+#include "core/scene_folder.h"
 #include "geometry/ground_plane.h"
 #include "geometry/triangle_mesh.h"
 
@@ -92,6 +93,16 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
 // there are neither triangles, nor points, nor cameras.
 SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& cloud,
                          const std::vector<FrameCamera>& cameras);
+
+// What a scene's frame is fitted to, read from its SceneFiles (core/scene_folder.h): each part empty where its file
+// does not exist (a scene folder has neither: its cameras alone make the frame).
+struct SceneGeometry {
+  TriangleMesh mesh;
+  TriangleMesh cloud;  // Positions, with normals and colours where the file has them.
+};
+
+// Throws BadInputError naming a file that cannot be read.
+SceneGeometry ReadSceneGeometry(const SceneFiles& files);
 
 // Two unit axes spanning the plane normal to `up` (unit), the first as close to world x as
 // possible: the directions of azimuth 0 and 90 degrees.

@@ -148,7 +148,8 @@ namespace {
 
 std::vector<NamedCamera> TargetCameras(const fs::path& input, const RenderTargets& cameras,
                                        const SourceLibrary& library) {
-  return cameras.path ? CamerasAlongPath(*cameras.path, input, library.Cameras(), library.Names())
+  // A scene folder has neither the mesh nor the cloud: its cameras alone make the frame.
+  return cameras.path ? CamerasAlongPath(*cameras.path, Workspace(input).Geometry(), library.Cameras(), library.Names())
                       : CamerasFromModel(cameras.model);
 }
 
@@ -249,7 +250,7 @@ RenderSummary RenderCameras(const fs::path& input, const RenderTargets& cameras,
   }
   summary.dropped = library.DropViewsWithoutDepth();
   const WorkspaceDepthPreparation depth_holes =
-      scene_folder ? WorkspaceDepthPreparation{} : PrepareWorkspaceDepth(input, settings, &library);
+      scene_folder ? WorkspaceDepthPreparation{} : PrepareWorkspaceDepth(Workspace(input).Mesh(), settings, &library);
   std::string csv;
   double hole_sum = 0, filled_sum = 0, ms_sum = 0;
   std::map<std::string, size_t> fill_skipped;  // Views by the reason their fill was skipped.

@@ -14,9 +14,6 @@
 #include "core/image.h"
 #include "core/pose.h"
 #include "core/sparse_model.h"
-#include "core/workspace.h"
-#include "geometry/obj.h"
-#include "geometry/ply.h"
 #include "geometry/scene_frame.h"
 #include "reproject/forward_warp.h"
 #include "reproject/scene_views.h"
@@ -41,20 +38,15 @@ int ParseCount(const std::string& text, const std::string& spec) {
   throw BadInputError("--path " + spec + ": '" + text + "' is not a frame count in 1..100000");
 }
 
-// The frame `parallax view` fits to the same workspace (viewer/viewer_scene.h): the mesh's
-// positions and triangles and the cloud's positions, read from the files the viewer reads, and
-// the cameras it shows.
-SceneFrame ReadSceneFrame(const fs::path& root, const std::vector<PosedCamera>& sources) {
-  const Workspace workspace(root);
-  TriangleMesh mesh;
-  std::vector<Eigen::Vector3f> cloud;
-  if (fs::exists(workspace.Mesh())) mesh = ReadTexturedMesh(workspace.Mesh());
-  if (fs::exists(workspace.Fused())) cloud = ReadPly(workspace.Fused()).vertices;
+// The frame `parallax view` fits to the same scene (viewer/viewer_scene.h): the mesh and the
+// cloud it shows, and the cameras it shows.
+SceneFrame ReadSceneFrame(const SceneFiles& files, const std::vector<PosedCamera>& sources) {
+  const SceneGeometry geometry = ReadSceneGeometry(files);
   std::vector<FrameCamera> cameras;
   for (const PosedCamera& source : sources) {
     if (IsProjectionSupported(source.camera.model)) cameras.push_back({source.camera, source.cam_from_world});
   }
-  return FitSceneFrame(mesh, cloud, cameras);
+  return FitSceneFrame(geometry.mesh, geometry.cloud.vertices, cameras);
 }
 
 // A rig whose cameras leave a gap wider than this (degrees of azimuth) does not surround the
@@ -71,8 +63,8 @@ double OrbitAzimuth(const SceneFrame& frame, int i, int n) {
 
 // Frame i on the DefaultOrbit for the first source's intrinsics, at OrbitAzimuth: where
 // `parallax view --orbit` stands at that azimuth with that camera's size and field of view.
-std::vector<NamedCamera> OrbitCameras(int frames, const fs::path& root, const std::vector<PosedCamera>& sources) {
-  const SceneFrame frame = ReadSceneFrame(root, sources);
+std::vector<NamedCamera> OrbitCameras(int frames, const SceneFiles& scene, const std::vector<PosedCamera>& sources) {
+  const SceneFrame frame = ReadSceneFrame(scene, sources);
   const Camera& camera = sources.front().camera;
   std::vector<NamedCamera> cameras;
   for (int i = 0; i < frames; ++i) {
@@ -147,28 +139,6 @@ std::vector<NamedCamera> PhotoTourCameras(int frames, const SceneFrame& frame,
   return cameras;
 }
 
-}  // namespace
-
-ViewSetPaths SourcePathsFor(const fs::path& root) {
-  const Workspace workspace(root);
-  if (fs::is_directory(workspace.Sparse()) && fs::is_directory(workspace.Images())) {
-    ViewSetPaths paths;
-    paths.images = workspace.Images();
-    paths.sparse = workspace.Sparse();
-    paths.depth = workspace.DepthDir();
-    paths.color_gains = workspace.ColorGainsFile();
-    return paths;
-  }
-  const SceneFolder scene{root};
-  if (fs::is_directory(scene.Training().sparse) && fs::is_directory(scene.Training().depth)) {
-    return scene.Training();
-  }
-  throw BadInputError(root.string() + " is neither a workspace (sparse/, images/: run parallax "
-                      "reconstruct) nor a scene folder (gt/sparse, gt/depth)");
-}
-
-namespace {
-
 // A camera from a file is rendered only within the image size limit, and only if its
 // distortion can be inverted somewhere (distorted_target.h).
 void CheckRenderable(const fs::path& model_dir, const NamedCamera& target) {
@@ -234,14 +204,14 @@ CameraPath ParseCameraPath(const std::string& spec) {
   throw BadInputError("--path " + spec + ": expected orbit:N, photos:N or between:IMAGE_A,IMAGE_B,N");
 }
 
-std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const fs::path& workspace_or_scene,
+std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const SceneFiles& scene,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names) {
   const std::string spec = path.Spec();
   if (sources.empty()) throw BadInputError("--path " + spec + ": there are no source cameras");
-  if (path.kind == CameraPath::Kind::kOrbit) return OrbitCameras(path.frames, workspace_or_scene, sources);
+  if (path.kind == CameraPath::Kind::kOrbit) return OrbitCameras(path.frames, scene, sources);
   if (path.kind == CameraPath::Kind::kPhotos) {
-    return PhotoTourCameras(path.frames, ReadSceneFrame(workspace_or_scene, sources), sources, source_names);
+    return PhotoTourCameras(path.frames, ReadSceneFrame(scene, sources), sources, source_names);
   }
   auto find = [&](const std::string& name) -> const PosedCamera& {
     for (size_t i = 0; i < source_names.size(); ++i) {
@@ -262,7 +232,7 @@ std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const fs::path
 
 SourceLibrary::SourceLibrary(ViewSetPaths paths) : paths_(std::move(paths)) {
   cameras_ = ReadPosedCameras(paths_, &names_);
-  if (!paths_.color_gains.empty() && fs::exists(paths_.color_gains)) gains_ = ReadColorGains(paths_.color_gains);
+  gains_ = ReadColorGainsIfPresent(paths_.color_gains);
   loaded_.resize(cameras_.size());
 }
 

@@ -10,16 +10,12 @@
 #include "core/color_gains.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
+#include "geometry/scene_frame.h"
 #include "reproject/render.h"
 #include "reproject/source_selection.h"
 #include "reproject/view.h"
 
 namespace parallax {
-
-// The sources of a workspace (<ws>/sparse, images, depth; depth maps may still be missing)
-// or of a scene folder (its training set). Throws BadInputError naming the folder when it is
-// neither.
-ViewSetPaths SourcePathsFor(const std::filesystem::path& workspace_or_scene);
 
 struct NamedCamera {
   std::string name;  // Output file stem.
@@ -56,12 +52,11 @@ struct CameraPath {
 // Throws BadInputError for a malformed spec (the message shows the forms above).
 CameraPath ParseCameraPath(const std::string& spec);
 
-// An orbit reads the frame's geometry from `workspace_or_scene`: mesh/mesh.obj and fused.ply
-// when present (the files `parallax view` shows); without either (a scene folder) the cameras
+// An orbit or a tour reads the frame's geometry from `scene` (ReadSceneGeometry: a workspace's
+// mesh and cloud, the files `parallax view` shows); without either (a scene folder) the cameras
 // alone make the frame (FitSceneFrame). Throws BadInputError when there are no sources,
 // `path` names an unknown image, or a mesh or cloud file is unreadable.
-std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path,
-                                          const std::filesystem::path& workspace_or_scene,
+std::vector<NamedCamera> CamerasAlongPath(const CameraPath& path, const SceneFiles& scene,
                                           const std::vector<PosedCamera>& sources,
                                           const std::vector<std::string>& source_names);
 

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <memory>
 
-#include "core/workspace.h"
 #include "geometry/raycaster.h"
 #include "geometry/obj.h"
 #include "reproject/background.h"
@@ -43,11 +42,10 @@ int FillFromMesh(const MeshRaycaster& caster, const SourceView& view, DepthMap* 
 
 }  // namespace
 
-WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& workspace,
+WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& obj,
                                                 const NovelViewSettings& settings,
                                                 SourceLibrary* library) {
   WorkspaceDepthPreparation result;
-  const std::filesystem::path obj = Workspace(workspace).Mesh();
   std::shared_ptr<const MeshRaycaster> caster;
   if (settings.depth_holes == DepthHoles::kNone) {
     result.note = "not requested (--depth-holes none)";

@@ -1,11 +1,9 @@
 #include "viewer/viewer_scene.h"
 
-#include "core/atomic_file.h"
+#include <utility>
+
 #include "core/error.h"
-#include "core/scene_folder.h"
 #include "core/sparse_model.h"
-#include "core/workspace.h"
-#include "geometry/ply.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -25,15 +23,14 @@ std::vector<ViewerSource> ReadSources(const fs::path& sparse_dir, const fs::path
 
 }  // namespace
 
-std::vector<ColoredPoint> ReadColoredPly(const fs::path& path) {
-  const TriangleMesh cloud = ReadPly(path);
+std::vector<ColoredPoint> ColoredPoints(const TriangleMesh& cloud, const fs::path& file) {
   std::vector<ColoredPoint> points(cloud.vertices.size());
   for (size_t i = 0; i < points.size(); ++i) {
     points[i].position = cloud.vertices[i];
     points[i].normal = cloud.normals.empty() ? Eigen::Vector3f::Zero() : cloud.normals[i];
     points[i].color = cloud.colors.empty() ? std::array<uint8_t, 3>{180, 180, 180} : cloud.colors[i];
     if (!points[i].normal.allFinite()) {
-      throw BadInputError(path.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
+      throw BadInputError(file.string() + ": vertex " + std::to_string(i) + " is NaN or Inf");
     }
   }
   return points;
@@ -56,28 +53,26 @@ void FinishViewerScene(ViewerScene& scene) {
   static_cast<SceneFrame&>(scene) = FitSceneFrame(scene.mesh, positions, FrameCameras(scene.sources));
 }
 
-ViewerScene LoadViewerScene(const fs::path& workspace) {
-  if (!fs::is_directory(workspace)) {
-    throw BadInputError(workspace.string() + ": not a folder (expected a parallax workspace)");
+ViewerScene LoadViewerScene(const ViewerScenePaths& paths) {
+  if (!fs::is_directory(paths.folder)) {
+    throw BadInputError(paths.folder.string() + ": not a folder (expected a parallax workspace)");
   }
+  SceneGeometry geometry = ReadSceneGeometry(paths.geometry);
   ViewerScene scene;
-  const Workspace ws(workspace);
-  const fs::path obj = ws.Mesh();
-  const fs::path ply = ws.Fused();
-  if (fs::exists(obj)) scene.mesh = ReadTexturedMesh(obj);
-  const fs::path display = ws.DisplayMesh();
-  if (!scene.mesh.triangles.empty() && fs::exists(display)) scene.display_mesh = ReadTexturedMesh(display);
-  if (fs::exists(ply)) scene.points = ReadColoredPly(ply);
-  if (scene.mesh.triangles.empty() && scene.points.empty()) {
-    throw BadInputError(workspace.string() +
-                        ": nothing to show: no mesh/mesh.obj and no fused.ply in this folder "
-                        "(run 'parallax reconstruct' first)");
+  scene.mesh = std::move(geometry.mesh);
+  if (!scene.mesh.triangles.empty() && fs::exists(paths.display_mesh)) {
+    scene.display_mesh = ReadTexturedMesh(paths.display_mesh);
   }
-  const SceneFolder scene_folder{workspace};
-  if (DetectSparseFormat(ws.Sparse())) {
-    scene.sources = ReadSources(ws.Sparse(), ws.Images(), ReadWorkspaceColorGains(workspace));
-  } else if (DetectSparseFormat(scene_folder.Training().sparse)) {
-    scene.sources = ReadSources(scene_folder.Training().sparse, scene_folder.Training().images, {});
+  scene.points = ColoredPoints(geometry.cloud, paths.geometry.cloud);
+  if (scene.mesh.triangles.empty() && scene.points.empty()) {
+    throw BadInputError(paths.folder.string() + ": nothing to show: no " +
+                        paths.geometry.mesh.lexically_relative(paths.folder).string() + " and no " +
+                        paths.geometry.cloud.lexically_relative(paths.folder).string() +
+                        " in this folder (run 'parallax reconstruct' first)");
+  }
+  if (!paths.photos.sparse.empty() && DetectSparseFormat(paths.photos.sparse)) {
+    const ColorGains gains = ReadColorGainsIfPresent(paths.photos.color_gains);
+    scene.sources = ReadSources(paths.photos.sparse, paths.photos.images, gains);
   }
   FinishViewerScene(scene);
   return scene;

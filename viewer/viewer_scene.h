@@ -14,6 +14,7 @@
 #include "core/camera.h"
 #include "core/color_gains.h"
 #include "core/pose.h"
+#include "core/scene_folder.h"
 #include "geometry/obj.h"
 #include "geometry/ground_plane.h"
 #include "geometry/scene_frame.h"
@@ -49,21 +50,28 @@ struct ViewerScene : SceneFrame {
   std::vector<ViewerSource> sources;
 };
 
-// Reads <ws>/mesh/mesh.obj (+ .mtl, .png), <ws>/mesh_display/mesh.obj when present, <ws>/fused.ply and the sparse model <ws>/sparse
-// with the photos in <ws>/images, then calls FinishViewerScene. Either of the mesh and the
-// cloud may be missing, not both. A scene folder (gt/sparse, images/) is accepted for the
-// cameras too. Throws BadInputError naming the folder when there is nothing to show, or the
-// file that is unreadable.
-ViewerScene LoadViewerScene(const std::filesystem::path& workspace);
+// Where the scene the viewer shows is read from.
+struct ViewerScenePaths {
+  std::filesystem::path folder;  // The folder the user named, for messages.
+  SceneFiles geometry;           // The mesh and the cloud (ReadSceneGeometry).
+  std::filesystem::path display_mesh;  // The mesh's simplified copy; no file: none.
+  ViewSetPaths photos;  // The sparse model, the photos and their color gains; no model: none.
+};
+
+// Reads the mesh (+ .mtl, .png), its display copy, the cloud and the photos' cameras of
+// `paths`, then calls FinishViewerScene. Either of the mesh and the cloud may be missing, not
+// both. Throws BadInputError naming the folder when there is nothing to show, or the file that
+// is unreadable.
+ViewerScene LoadViewerScene(const ViewerScenePaths& paths);
 
 // Fits the scene's frame to the mesh, the points and the sources (FitSceneFrame: bounds,
 // robust extent, ground plane, up, focus, camera rig). Call after filling mesh, points and
 // sources by hand (tests). Throws BadInputError if the scene has neither triangles nor points.
 void FinishViewerScene(ViewerScene& scene);
 
-// The points of a PLY cloud (our fused.ply or COLMAP's), read by geometry/ply.h: normals zero
-// and colors grey where the file has none. Throws BadInputError naming the file.
-std::vector<ColoredPoint> ReadColoredPly(const std::filesystem::path& path);
+// The points of a cloud read from `file` (our fused.ply or COLMAP's): normals zero and colors
+// grey where the file has none. Throws BadInputError naming the file for a non-finite normal.
+std::vector<ColoredPoint> ColoredPoints(const TriangleMesh& cloud, const std::filesystem::path& file);
 
 // The sources as the scene frame sees them (geometry/scene_frame.h).
 std::vector<FrameCamera> FrameCameras(const std::vector<ViewerSource>& sources);

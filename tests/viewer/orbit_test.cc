@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "apps/viewer_paths.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/pose.h"
@@ -105,14 +106,14 @@ void WriteGeometry(const fs::path& ws) {
 // The 12 cameras `parallax render --path orbit:12` renders for `ws`.
 std::vector<NamedCamera> RenderOrbit(const fs::path& ws) {
   const SourceLibrary library(SourcePathsFor(ws));
-  return CamerasAlongPath(ParseCameraPath("orbit:12"), ws, library.Cameras(), library.Names());
+  return CamerasAlongPath(ParseCameraPath("orbit:12"), Workspace(ws).Geometry(), library.Cameras(), library.Names());
 }
 
 // Render's orbit frame k against `view --orbit 30k --size 320x240 --fov F`, F the photos'
 // horizontal field of view.
 void ExpectRenderOrbitIsViewOrbit(const fs::path& ws) {
   const std::vector<NamedCamera> render = RenderOrbit(ws);
-  const ViewerScene scene = LoadViewerScene(ws);
+  const ViewerScene scene = LoadViewerScene(ViewerScenePathsFor(ws));
   const double fov_deg = 2 * std::atan(0.5 * kWidth / kFocal) * 180 / std::numbers::pi;
   ASSERT_EQ(render.size(), 12u);
   for (int k = 0; k < 12; ++k) {
@@ -131,7 +132,7 @@ TEST(Orbit, RenderOrbitIsTheViewOrbitAroundARig) {
   const fs::path ws = dir.Path() / "ws";
   WriteCameras(ws, 8, RingCamera);
   WriteGeometry(ws);
-  ASSERT_TRUE(LoadViewerScene(ws).rig.has_value()) << "the ring looks in at the box";
+  ASSERT_TRUE(LoadViewerScene(ViewerScenePathsFor(ws)).rig.has_value()) << "the ring looks in at the box";
   ExpectRenderOrbitIsViewOrbit(ws);
 }
 
@@ -140,7 +141,7 @@ TEST(Orbit, RenderOrbitIsTheViewOrbitAroundTheFocusWithoutARig) {
   const fs::path ws = dir.Path() / "ws";
   WriteCameras(ws, 8, WalkCamera);
   WriteGeometry(ws);
-  ASSERT_FALSE(LoadViewerScene(ws).rig.has_value()) << "cameras looking ahead make no rig";
+  ASSERT_FALSE(LoadViewerScene(ViewerScenePathsFor(ws)).rig.has_value()) << "cameras looking ahead make no rig";
   ExpectRenderOrbitIsViewOrbit(ws);
 }
 
@@ -151,7 +152,7 @@ TEST(Orbit, RenderOrbitKeepsToTheArcThePhotosWereTakenFrom) {
   const fs::path ws = dir.Path() / "ws";
   WriteCameras(ws, 6, ArcCamera);
   WriteGeometry(ws);
-  const ViewerScene scene = LoadViewerScene(ws);
+  const ViewerScene scene = LoadViewerScene(ViewerScenePathsFor(ws));
   ASSERT_TRUE(scene.rig.has_value());
   EXPECT_NEAR(scene.rig->arc_span_deg, 100, 0.01);  // The rig's target is a least-squares fit.
   const std::vector<NamedCamera> render = RenderOrbit(ws);
@@ -179,7 +180,7 @@ TEST(Orbit, PhotoTourRunsThroughThePhotoCameras) {
   WriteGeometry(ws);
   const SourceLibrary library(SourcePathsFor(ws));
   const std::vector<NamedCamera> tour =
-      CamerasAlongPath(ParseCameraPath("photos:21"), ws, library.Cameras(), library.Names());
+      CamerasAlongPath(ParseCameraPath("photos:21"), Workspace(ws).Geometry(), library.Cameras(), library.Names());
   ASSERT_EQ(tour.size(), 21u);
   const auto centre = [&](size_t k) { return CameraCenter(tour[k].camera.cam_from_world); };
   EXPECT_LT((centre(0) - CameraCenter(ArcCamera(0))).norm(), 1e-9);

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "apps/viewer_paths.h"
 #include "core/error.h"
 #include "core/sparse_model.h"
 #include "tests/temp_dir.h"
@@ -128,7 +129,7 @@ TEST(ViewerProjective, NearestSourceViewsAreThoseAroundTheEye) {
 TEST(ViewerScene, EmptyWorkspaceIsBadInputNamingTheFolder) {
   const TempDir dir;
   try {
-    LoadViewerScene(dir.Path());
+    LoadViewerScene(ViewerScenePathsFor(dir.Path()));
     FAIL() << "expected BadInputError";
   } catch (const BadInputError& error) {
     EXPECT_NE(std::string(error.what()).find(dir.Path().string()), std::string::npos) << error.what();
