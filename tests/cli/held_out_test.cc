@@ -36,8 +36,9 @@ nlohmann::json ReadJson(const fs::path& path) {
 }
 
 std::vector<std::string> ImageNames(const fs::path& model) {
+  const SparseModel sparse = ReadSparseModel(model);
   std::vector<std::string> names;
-  for (const SparseImage& image : ReadSparseModel(model).Images()) names.push_back(image.name);
+  for (const SparseImage& image : sparse.Images()) names.push_back(image.name);
   std::sort(names.begin(), names.end());
   return names;
 }
