@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/angles.h"
 #include "core/error.h"
 #include "geometry/obj.h"
 #include "geometry/ply.h"
@@ -15,8 +16,6 @@
 
 namespace parallax {
 namespace {
-
-double Radians(double degrees) { return degrees * std::numbers::pi / 180; }
 
 // Points spread over the mesh by area (deterministic), so a large ground made of two
 // triangles weighs as much as it covers.

@@ -6,10 +6,10 @@
 #include <utility>
 #include <numbers>
 
+#include "core/angles.h"
+
 namespace parallax {
 namespace {
-
-double Radians(double degrees) { return degrees * std::numbers::pi / 180; }
 
 // Maps depth in [near, far] of an orthographic/perspective row to the NDC range in use.
 Eigen::Vector2d NdcZRange(DepthRange range) {
