@@ -14,6 +14,7 @@
 #include "bench/bench_runner.h"
 
 #include "core/atomic_file.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
@@ -50,7 +51,7 @@ class Bench {
       log_file << line << "\n";
       run.output.append(line).append("\n");
     });
-    run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    run.wall_s = SecondsSince(start);
     run.peak_mb = static_cast<double>(result.peak_memory_kb) / 1024.0;
     std::fprintf(stderr, " %.1f s\n", run.wall_s);
     if (result.exit_code != 0) {
@@ -394,7 +395,7 @@ BenchSummary RunBench(const fs::path& scene_dir, const fs::path& out_dir, BenchG
     stages.pop_back();
   }
   BenchSummary summary;
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = SecondsSince(start);
   summary.runs = bench.rows.size();
   WriteBenchReport(bench.Out(), bench.rows, stages, DescribeMachine(), bench.leave_out, summary.seconds);
   return summary;

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/sparse_model.h"
@@ -19,10 +20,6 @@
 namespace parallax {
 namespace fs = std::filesystem;
 namespace {
-
-double Seconds(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // PlanDepth, its error naming the workspace.
 DepthPlan PlanWorkspaceDepth(const Workspace& ws, const SparseModel& model, const MvsOptions& options) {
@@ -188,12 +185,12 @@ MvsSummary RunMultiViewStereo(const Workspace& workspace, const MvsOptions& opti
   const ResumedViews resumed = PrepareEstimates(workspace, key);
   auto start = std::chrono::steady_clock::now();
   RunMultiViewStereoBlock(workspace, options, {MvsPass::kPhotometric}, progress);
-  const double photometric_seconds = Seconds(start);
+  const double photometric_seconds = SecondsSince(start);
   start = std::chrono::steady_clock::now();
   RunMultiViewStereoBlock(workspace, options, {MvsPass::kGeometric}, progress);
   MvsSummary summary = FinishMultiViewStereoBlocks(workspace, options);
   summary.photometric_seconds = photometric_seconds;
-  summary.geometric_seconds = Seconds(start);
+  summary.geometric_seconds = SecondsSince(start);
   summary.resumed_estimates = resumed.estimates;
   summary.resumed_filtered = resumed.filtered;
   return summary;
@@ -260,7 +257,7 @@ MvsSummary RunSgbmStereo(const Workspace& workspace, const ViewSelectionOptions&
     summary.views.push_back(std::move(view->report));
   }
   progress.Update("sgbm", total, total);
-  summary.photometric_seconds = Seconds(start);
+  summary.photometric_seconds = SecondsSince(start);
   return summary;
 }
 

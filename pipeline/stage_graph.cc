@@ -1,5 +1,6 @@
 #include "pipeline/stage_graph.h"
 
+#include "core/elapsed.h"
 #include "core/memory.h"
 
 #include <algorithm>
@@ -35,7 +36,7 @@ void StageGraph::Run(const Stage& stage) {
     const double cpu_start = CpuSeconds();
     const auto start = std::chrono::steady_clock::now();
     stage.run();
-    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.seconds = SecondsSince(start);
     record.peak_rss_mb = PeakResidentMemoryMb();
     record.tool_peak_rss_mb = PeakChildResidentMemoryMb();
     record.cpu_seconds = CpuSeconds() - cpu_start;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/depth_map.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "reproject/distorted_target.h"
 #include "core/image.h"
@@ -357,7 +358,7 @@ void RenderNovelView(SourceLibrary& library, const NamedCamera& target,
     RenderNovelView(library, pinhole, selection, renderer, view);
     const auto start = Clock::now();
     ResampleIntoDistorted(camera, pinhole.camera.camera, &view->result);
-    view->ms += std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    view->ms += MsSince(start);
     return;
   }
   const auto select_start = Clock::now();

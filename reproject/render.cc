@@ -13,6 +13,7 @@
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "reproject/fill_from_sources.h"
 
@@ -20,10 +21,6 @@ namespace parallax {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double MsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 // Bands of target rows each of `warps` concurrent warps draws in parallel: enough for every
 // thread to have one. A band walks the whole source mesh, so a warp drawn in two bands costs

@@ -8,6 +8,7 @@
 
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
+#include "core/elapsed.h"
 #include "core/image.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
@@ -89,8 +90,7 @@ SynthSummary RenderSceneFolder(const SceneDesc& scene, const std::string& scene_
   SynthSummary summary;
   summary.training_views = static_cast<int>(scene.training.size());
   summary.novel_views = static_cast<int>(scene.novel.size());
-  summary.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = SecondsSince(start);
   return summary;
 }
 

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <numbers>
 
+#include "core/elapsed.h"
 #include "core/image.h"
 #include "viewer/egl_context.h"
 #include "viewer/view_cameras.h"
@@ -11,10 +12,6 @@
 
 namespace parallax {
 namespace {
-
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-}
 
 // The median and fastest of `frames` frames, each finished with glFinish; `before_frame(i)` may
 // change the settings and the view first.

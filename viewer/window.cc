@@ -12,9 +12,10 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "core/check.h"
+#include "core/elapsed.h"
 #include "core/error.h"
 #include "core/image.h"
-#include "core/check.h"
 #include "viewer/view_cameras.h"
 #include "viewer/view_math.h"
 
@@ -279,7 +280,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
         renderer.Draw(view, state.settings, 0);
       }
       glFinish();  // So the time measures the frame, not the command submission.
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      const double ms = MsSince(start);
       smoothed_ms = smoothed_ms == 0 ? ms : 0.9 * smoothed_ms + 0.1 * ms;
       if (state.screenshot_requested) {
         state.screenshot_requested = false;
