@@ -21,11 +21,7 @@ void WriteTexturedMesh(const std::filesystem::path& dir, const TriangleMesh& mes
 // one is at fault, for anything else.
 TriangleMesh ReadTexturedMesh(const std::filesystem::path& obj_path);
 
-// Color (first 3 channels) at a continuous pixel position (pixel centres at integer + 0.5),
-// bilinear between pixel centres, clamped at the border.
-Eigen::Vector3f SampleBilinear(const Image& image, const Eigen::Vector2f& pixel);
-
-// Atlas color at `uv` (OBJ convention), through SampleBilinear.
+// Atlas color at `uv` (OBJ convention), through SampleBilinear (core/image_sampling.h).
 Eigen::Vector3f SampleAtlas(const Image& atlas, const Eigen::Vector2f& uv);
 
 }  // namespace parallax

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.h"
+#include "core/image_sampling.h"
 #include "geometry/raycaster.h"
 #include "core/check.h"
 
