@@ -25,6 +25,7 @@ struct ViewArguments {
   std::filesystem::path workspace;
   std::filesystem::path screenshot;
   std::filesystem::path screenshot_dir = ".";  // The window's S key.
+  double motion_hold_ms = WindowOptions().motion_hold_ms;
   std::string camera;
   std::optional<double> orbit_deg;
   std::optional<double> elevation_deg;  // Default: the source cameras' elevation, else 30.
@@ -178,6 +179,10 @@ void RegisterViewCommand(CLI::App& app) {
                     "mesh and light, and print the intersection over union");
   command->add_option("--screenshot-dir", a->screenshot_dir,
                       "in the window: where the S key writes view-<n>.png (default: the current folder)");
+  command->add_option("--motion-hold-ms", a->motion_hold_ms,
+                      "in the window: how long after a drag or a light move frames are drawn at half "
+                      "resolution, to keep the motion smooth (default 200; 0: always full resolution)")
+      ->check(CLI::Range(0.0, 60000.0));
   command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
   command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
   command->callback([a] {
@@ -199,6 +204,7 @@ void RegisterViewCommand(CLI::App& app) {
     options.light_azimuth_deg = light[0];
     options.light_elevation_deg = light[1];
     options.screenshot_dir = a->screenshot_dir;
+    options.motion_hold_ms = a->motion_hold_ms;
     RunViewerWindow(scene, settings, options, SourceIndex(scene, a->camera),
                     [](const std::string& text) {
                       std::fputs(text.c_str(), stdout);

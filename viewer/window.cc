@@ -62,9 +62,6 @@ struct WindowState {
   std::chrono::steady_clock::time_point camera_moved, light_moved;
 };
 
-// How long after the last input the window keeps drawing with reduced detail.
-constexpr std::chrono::milliseconds kMotionHold(200);
-
 WindowState* State(GLFWwindow* window) {
   return static_cast<WindowState*>(glfwGetWindowUserPointer(window));
 }
@@ -218,6 +215,8 @@ void WindowOptions::Check() const {
   RequireOption(width >= 16, "WindowOptions.width", width, ">= 16");
   RequireOption(height >= 16, "WindowOptions.height", height, ">= 16");
   RequireOption(fov_deg > 1 && fov_deg < 170, "WindowOptions.fov_deg", fov_deg, "(1, 170)");
+  RequireOption(motion_hold_ms >= 0 && motion_hold_ms <= 60000, "WindowOptions.motion_hold_ms", motion_hold_ms,
+                "[0, 60000]");
 }
 
 std::string ViewerKeyHelp() {
@@ -264,6 +263,7 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
   glfwSetScrollCallback(glfw.window, OnScroll);
   log(ViewerKeyHelp());
 
+  const std::chrono::duration<double, std::milli> motion_hold(options.motion_hold_ms);
   double smoothed_ms = 0;
   int screenshots = 0;
   while (!glfwWindowShouldClose(glfw.window)) {
@@ -271,8 +271,8 @@ void RunViewerWindow(const ViewerScene& scene, FrameSettings settings, const Win
     glfwGetFramebufferSize(glfw.window, &width, &height);
     if (width > 0 && height > 0) {
       const auto start = std::chrono::steady_clock::now();
-      const bool light_moving = start - state.light_moved < kMotionHold;
-      const bool moving = light_moving || start - state.camera_moved < kMotionHold;
+      const bool light_moving = start - state.light_moved < motion_hold;
+      const bool moving = light_moving || start - state.camera_moved < motion_hold;
       const ViewCamera view = CurrentView(state, width, height);
       if (moving) {
         renderer.Draw(MovingView(view), MovingSettings(state.settings, light_moving), 0, width, height);

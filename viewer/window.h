@@ -22,6 +22,9 @@ struct WindowOptions {
   double light_azimuth_deg = 45;    // The light's start (LightDirectionFromAngles); the arrows
   double light_elevation_deg = 50;  // move it from there.
   std::filesystem::path screenshot_dir = ".";  // Where the S key writes view-<n>.png.
+  // How long after the camera or the light last moved frames are drawn at half resolution, so
+  // that a drag stays smooth where a full frame is slow; 0: always full.
+  double motion_hold_ms = 200;
   void Check() const;      // Throws UsageError naming the field.
 };
 
