@@ -10,7 +10,7 @@
 #include "core/quality.h"
 #include "core/workspace.h"
 #include "mvs/mvs.h"
-#include "pipeline/reconstruct.h"
+#include "pipeline/reconstruct_options.h"
 #include "pipeline/stage_graph.h"
 
 namespace parallax {

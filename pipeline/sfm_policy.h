@@ -14,7 +14,7 @@
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "pipeline/key_photos.h"
-#include "pipeline/reconstruct.h"
+#include "pipeline/reconstruct_options.h"
 #include "sfm/photo_set.h"
 #include "sfm/quality_settings.h"
 

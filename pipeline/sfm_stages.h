@@ -12,7 +12,7 @@
 #include "core/progress.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
-#include "pipeline/reconstruct.h"
+#include "pipeline/reconstruct_options.h"
 #include "pipeline/sfm_policy.h"
 #include "pipeline/stage_graph.h"
 #include "sfm/photo_set.h"

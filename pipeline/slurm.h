@@ -13,7 +13,7 @@
 
 #include "core/progress.h"
 #include "pipeline/depth_workspace.h"
-#include "pipeline/reconstruct.h"
+#include "pipeline/reconstruct_options.h"
 
 namespace parallax {
 
