@@ -59,6 +59,13 @@ class PlantedIncludes(unittest.TestCase):
         code, output = self.check("pipeline/planted.cc", "core/workspace.h")
         self.assertEqual(code, 0, output)
 
+    def test_the_part_of_a_folder_it_links_gives_that_parts_headers_alone(self):
+        code, output = self.check("eval/planted.cc", "viewer/frame.h")
+        self.assertEqual(code, 0, output)
+        code, output = self.check("eval/planted.cc", "viewer/renderer.h")
+        self.assertEqual(code, 1, output)
+        self.assertIn("eval/planted.cc:1: includes viewer/renderer.h", output)
+
     def test_a_folder_it_does_not_link_fails(self):
         code, output = self.check("viewer/planted.cc", "pipeline/reconstruct.h")
         self.assertEqual(code, 1, output)
