@@ -133,17 +133,50 @@ void PrintMeshHeldOut(const TexturedMeshScore& mesh, const std::filesystem::path
   std::printf(" (%s)\n", dir.string().c_str());
 }
 
+struct EvaluateArguments {
+  std::filesystem::path workspace;
+  std::filesystem::path scene;
+  std::filesystem::path json;
+  bool no_align = false;
+  EvaluateOptions options;
+};
+
+// Evaluates under the workspace's exclusive lock, prints each part and writes the JSON.
+void RunEvaluate(EvaluateArguments& arguments) {
+  arguments.options.align = !arguments.no_align;
+  arguments.options.novel.Resolve();
+  const Workspace workspace(arguments.workspace);
+  // It writes evaluation/ (and missing color gains) into the workspace.
+  const WorkspaceLock lock(workspace.Root(), LockMode::kExclusive, "evaluate");
+  WorkspaceEvaluation evaluation;
+  if (arguments.options.novel.color_gains && !arguments.options.gt_sources) {
+    const std::string note = EnsureColorGains(workspace);
+    if (!note.empty()) std::printf("%s\n", note.c_str());
+  }
+  {
+    TerminalProgress progress;
+    evaluation = arguments.scene.empty()
+                     ? EvaluateHeldOut(workspace, arguments.options)
+                     : EvaluateWorkspace(workspace, SceneFolder{arguments.scene}, arguments.options, progress);
+  }
+  if (!evaluation.held_out) PrintPoses(evaluation.poses);
+  PrintDepth(evaluation, workspace);
+  PrintCloudAndMesh(evaluation);
+  if (evaluation.novel) PrintNovel(*evaluation.novel);
+  if (evaluation.mesh_held_out) {
+    PrintMeshHeldOut(*evaluation.mesh_held_out, evaluation.mesh_held_out_dir,
+                     !arguments.options.mesh_common_with.empty());
+  }
+  const std::filesystem::path out =
+      arguments.json.empty() ? EvaluationLayout(workspace.Root()).Json() : arguments.json;
+  WriteFileAtomically(out, nlohmann::json(evaluation).dump(2) + "\n");
+  std::printf("json: %s\n", out.string().c_str());
+}
+
 }  // namespace
 
 void RegisterEvaluateCommand(CLI::App& app) {
-  struct Arguments {
-    std::filesystem::path workspace;
-    std::filesystem::path scene;
-    std::filesystem::path json;
-    bool no_align = false;
-    EvaluateOptions options;
-  };
-  auto arguments = std::make_shared<Arguments>();
+  auto arguments = std::make_shared<EvaluateArguments>();
   CLI::App* command = app.add_subcommand(
       "evaluate", "Measure a workspace against a scene folder's ground truth (--gt): camera poses "
                   "after a robust similarity alignment (Ceres), depth maps, cloud and mesh where the "
@@ -185,36 +218,7 @@ void RegisterEvaluateCommand(CLI::App& app) {
                       "is taken as the photos' own colors (no color gains). bench/openmvs-mesh uses it")
       ->check(CLI::ExistingFile);
   AddNovelViewOptions(*command, arguments->options.novel);
-  command->callback([arguments] {
-    arguments->options.align = !arguments->no_align;
-    arguments->options.novel.Resolve();
-    const Workspace workspace(arguments->workspace);
-    // It writes evaluation/ (and missing color gains) into the workspace.
-    const WorkspaceLock lock(workspace.Root(), LockMode::kExclusive, "evaluate");
-    WorkspaceEvaluation evaluation;
-    if (arguments->options.novel.color_gains && !arguments->options.gt_sources) {
-      const std::string note = EnsureColorGains(workspace);
-      if (!note.empty()) std::printf("%s\n", note.c_str());
-    }
-    {
-      TerminalProgress progress;
-      evaluation = arguments->scene.empty()
-                       ? EvaluateHeldOut(workspace, arguments->options)
-                       : EvaluateWorkspace(workspace, SceneFolder{arguments->scene}, arguments->options, progress);
-    }
-    if (!evaluation.held_out) PrintPoses(evaluation.poses);
-    PrintDepth(evaluation, workspace);
-    PrintCloudAndMesh(evaluation);
-    if (evaluation.novel) PrintNovel(*evaluation.novel);
-    if (evaluation.mesh_held_out) {
-      PrintMeshHeldOut(*evaluation.mesh_held_out, evaluation.mesh_held_out_dir,
-                       !arguments->options.mesh_common_with.empty());
-    }
-    const std::filesystem::path out =
-        arguments->json.empty() ? EvaluationLayout(workspace.Root()).Json() : arguments->json;
-    WriteFileAtomically(out, nlohmann::json(evaluation).dump(2) + "\n");
-    std::printf("json: %s\n", out.string().c_str());
-  });
+  command->callback([arguments] { RunEvaluate(*arguments); });
 }
 
 }  // namespace parallax

@@ -13,17 +13,70 @@
 
 namespace parallax {
 
-void RegisterRenderCommand(CLI::App& app) {
-  struct Arguments {
-    std::filesystem::path input;
-    std::filesystem::path cameras;
-    std::string path;
-    std::filesystem::path out;
-    NovelViewSettings settings;
-    SlurmCli slurm;
-    RenderPart part;
+namespace {
+
+struct RenderArguments {
+  std::filesystem::path input;
+  std::filesystem::path cameras;
+  std::string path;
+  std::filesystem::path out;
+  NovelViewSettings settings;
+  SlurmCli slurm;
+  RenderPart part;
+};
+
+void PrintRenderSummary(const RenderSummary& summary, const RenderArguments& arguments) {
+  if (arguments.part.step != RenderStep::kAll) {
+    for (const RequestStage& stage : summary.stages) {
+      std::printf("render %s: %s\n", stage.name.c_str(), stage.reason.c_str());
+    }
+    return;
+  }
+  if (!summary.depth_note.empty()) std::printf("depth: %s\n", summary.depth_note.c_str());
+  for (const std::string& name : summary.dropped) {
+    std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n", name.c_str());
+  }
+  std::printf("rendered %zu views from %d of %zu source views (the others were never loaded); "
+              "mean hole ratio %.2f%% before filling, %.2f%% after; %.1f ms per view -> %s\n",
+              summary.views, summary.sources_loaded, summary.source_views, 100 * summary.hole_ratio_mean,
+              100 * summary.hole_ratio_filled_mean, summary.ms_per_view, arguments.out.string().c_str());
+}
+
+// The cameras as the command line names them; submitted to Slurm or rendered here.
+void RunRender(RenderArguments& arguments, const CLI::App& command) {
+  arguments.settings.Resolve();
+  if (arguments.cameras.empty() && arguments.path.empty()) {
+    throw CLI::ValidationError("render", "give the cameras: --cameras <model_dir> or --path <spec>");
+  }
+  const RenderTargets targets{arguments.cameras, arguments.path.empty()
+                                                     ? std::nullopt
+                                                     : std::optional(ParseCameraPath(arguments.path))};
+  if (arguments.slurm.OnSlurm()) {
+    const SlurmOptions slurm = arguments.slurm.Resolve();
+    const SlurmSubmission submission = SubmitRenderToSlurm(
+        arguments.out, CountRenderTargets(arguments.input, targets), ThisExecutable(),
+        JobArguments(command, {arguments.input}, {"--out", "--cameras"}), slurm);
+    PrintSubmission(submission, slurm.wait);
+    return;
+  }
+  const auto print_view = [](size_t i, size_t count, const NamedCamera& target, const NovelView& view) {
+    std::fprintf(stderr, "render %zu/%zu %s: %zu sources, holes %.2f%% -> %.2f%% filled, %.0f ms\n", i + 1, count,
+                 target.name.c_str(), view.sources.size(), 100 * view.result.metrics.hole_ratio,
+                 100 * view.result.fill.hole_ratio_filled, view.ms);
   };
-  auto arguments = std::make_shared<Arguments>();
+  RenderSummary summary;
+  {
+    TerminalProgress progress;
+    summary = RenderCameras(arguments.input, targets, arguments.settings, arguments.out, progress, print_view,
+                            arguments.part);
+  }
+  PrintRenderSummary(summary, arguments);
+}
+
+}  // namespace
+
+void RegisterRenderCommand(CLI::App& app) {
+  auto arguments = std::make_shared<RenderArguments>();
   CLI::App* command = app.add_subcommand(
       "render",
       "Render novel viewpoints by depth-image-based warping from the photos and depth maps of "
@@ -53,51 +106,7 @@ void RegisterRenderCommand(CLI::App& app) {
       ->group("");
   command->add_option("--block", arguments->part.block)->check(CLI::NonNegativeNumber)->group("");
   command->add_option("--block-size", arguments->part.block_size)->check(CLI::PositiveNumber)->group("");
-  command->callback([arguments, command] {
-    arguments->settings.Resolve();
-    if (arguments->cameras.empty() && arguments->path.empty()) {
-      throw CLI::ValidationError("render", "give the cameras: --cameras <model_dir> or --path <spec>");
-    }
-    const RenderTargets targets{arguments->cameras, arguments->path.empty()
-                                                        ? std::nullopt
-                                                        : std::optional(ParseCameraPath(arguments->path))};
-    if (arguments->slurm.OnSlurm()) {
-      const SlurmOptions slurm = arguments->slurm.Resolve();
-      const SlurmSubmission submission = SubmitRenderToSlurm(
-          arguments->out, CountRenderTargets(arguments->input, targets), ThisExecutable(),
-          JobArguments(*command, {arguments->input}, {"--out", "--cameras"}), slurm);
-      PrintSubmission(submission, slurm.wait);
-      return;
-    }
-    const auto print_view = [](size_t i, size_t count, const NamedCamera& target, const NovelView& view) {
-      std::fprintf(stderr, "render %zu/%zu %s: %zu sources, holes %.2f%% -> %.2f%% filled, %.0f ms\n",
-                   i + 1, count, target.name.c_str(), view.sources.size(),
-                   100 * view.result.metrics.hole_ratio, 100 * view.result.fill.hole_ratio_filled,
-                   view.ms);
-    };
-    RenderSummary summary;
-    {
-      TerminalProgress progress;
-      summary = RenderCameras(arguments->input, targets, arguments->settings, arguments->out, progress, print_view,
-                              arguments->part);
-    }
-    if (arguments->part.step != RenderStep::kAll) {
-      for (const RequestStage& stage : summary.stages) {
-        std::printf("render %s: %s\n", stage.name.c_str(), stage.reason.c_str());
-      }
-      return;
-    }
-    if (!summary.depth_note.empty()) std::printf("depth: %s\n", summary.depth_note.c_str());
-    for (const std::string& name : summary.dropped) {
-      std::fprintf(stderr, "render: %s has no depth map (none could be estimated); not used\n",
-                   name.c_str());
-    }
-    std::printf("rendered %zu views from %d of %zu source views (the others were never loaded); "
-                "mean hole ratio %.2f%% before filling, %.2f%% after; %.1f ms per view -> %s\n",
-                summary.views, summary.sources_loaded, summary.source_views,
-                100 * summary.hole_ratio_mean, 100 * summary.hole_ratio_filled_mean,
-                summary.ms_per_view, arguments->out.string().c_str());
-  });
+  command->callback([arguments, command] { RunRender(*arguments, *command); });
 }
 
 }  // namespace parallax

@@ -119,6 +119,102 @@ void PrintScreenshot(const ViewArguments& a, const ViewerScene& scene, const Fra
   std::printf("\n");
 }
 
+// Where the view stands: a source camera or an orbit, and the image size.
+void AddViewpointOptions(CLI::App& command, ViewArguments& a) {
+  auto* camera = command.add_option("--camera", a.camera, "view from this source camera (image name or stem)");
+  command.add_option("--orbit", a.orbit_deg,
+                     "view from an orbit about the scene at this azimuth (degrees); it looks where the source "
+                     "cameras look, from as far, when they surround the scene")
+      ->excludes(camera);
+  command.add_option("--elevation", a.elevation_deg,
+                     "orbit elevation above the ground (degrees; default: the source cameras' when they "
+                     "surround the scene, else 30)");
+  command.add_option("--fov", a.fov_deg, "orbit camera's horizontal field of view (degrees, default 50)")
+      ->check(CLI::Range(1.0, 170.0));
+  command.add_option("--size", a.size, "image size WxH (default 1280x720; a source camera's own size)");
+}
+
+// What the frame shows and how: shadows, texture, light, exposure.
+void AddLookOptions(CLI::App& command, ViewArguments& a) {
+  command.add_option("--shadows", a.shadows,
+                     "auto|none|blob|planar|map|pcf|volume (default auto: none for projected photos, "
+                     "volume for a mesh of up to 4000 triangles, else pcf; it says which)")
+      ->transform(CLI::IsMember({"auto", "none", "blob", "planar", "map", "pcf", "volume"}, CLI::ignore_case));
+  const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
+                                                    {"projective", TextureMode::kProjective},
+                                                    {"shaded", TextureMode::kShaded},
+                                                    {"matcap", TextureMode::kMatcap}};
+  command.add_option("--texture", a.texture, "atlas|projective|shaded|matcap (default atlas; matcap: the atlas with a sphere-map specular)")
+      ->transform(CLI::CheckedTransformer(textures, CLI::ignore_case));
+  command.add_option("--light", a.light, "directional light azimuth,elevation in degrees (default 45,50)");
+  command.add_option("--point-light", a.point_light, "a point light at x,y,z (world) instead");
+  command.add_option("--exposure", a.settings.exposure_stops, "exposure in stops (default 0)");
+  const std::map<std::string, ToneMap> tone_maps{
+      {"clamp", ToneMap::kClamp}, {"reinhard", ToneMap::kReinhard}, {"aces", ToneMap::kAces}};
+  command.add_option("--tone-map", a.settings.tone_map,
+                     "clamp|reinhard|aces: how linear light becomes display values (default clamp: values over 1 "
+                     "clip; reinhard and aces render into a float frame first)")
+      ->transform(CLI::CheckedTransformer(tone_maps, CLI::ignore_case));
+  command.add_option("--white", a.settings.white, "reinhard: the exposed value shown as white (default 4)")
+      ->check(CLI::Range(1.0, 1e6));
+  command.add_flag("--auto-exposure", a.settings.auto_exposure,
+                   "expose each frame for its log-average luminance (mid grey 0.18), tone-mapped; in the window "
+                   "the eye adapts over half a second");
+  command.add_option("--light-intensity", a.settings.light.intensity,
+                     "the light's irradiance, linear (default 1; a point light's at the scene's centre)")
+      ->check(CLI::Range(0.0, 1e6));
+  command.add_option("--shadow-map-size", a.settings.shadow_map_size, "shadow map side in texels (default 2048)")
+      ->check(CLI::Range(64, 8192));
+  command.add_option("--pcf-radius", a.settings.pcf_radius, "PCF kernel radius in texels (default 1)")
+      ->check(CLI::Range(0, 4));
+}
+
+// The screenshot's measurements and the window's controls.
+void AddScreenshotAndWindowOptions(CLI::App& command, ViewArguments& a) {
+  command.add_option("--time-frames", a.timed_frames,
+                     "with --screenshot: draw this many more frames and print the median frame time")
+      ->check(CLI::Range(1, 10000));
+  command.add_flag("--shadow-iou", a.shadow_iou,
+                   "with --screenshot: compare its shadow mask with one ray-traced by Embree for the same "
+                   "mesh and light, and print the intersection over union");
+  command.add_option("--screenshot-dir", a.screenshot_dir,
+                     "in the window: where the S key writes view-<n>.png (default: the current folder)");
+  command.add_option("--motion-hold-ms", a.motion_hold_ms,
+                     "in the window: how long after a drag or a light move frames are drawn at half "
+                     "resolution, to keep the motion smooth (default 200; 0: always full resolution)")
+      ->check(CLI::Range(0.0, 60000.0));
+  command.add_flag("--no-cameras", a.no_cameras, "hide the source cameras");
+  command.add_flag("--no-grid", a.no_grid, "hide the ground grid");
+}
+
+// Reads the scene under a shared lock, then writes the screenshot or opens the window.
+void RunView(const ViewArguments& a) {
+  const ViewerScene scene = [&] {
+    const WorkspaceLock lock(a.workspace, LockMode::kShared, "view");  // While it reads.
+    return LoadViewerScene(ViewerScenePathsFor(a.workspace));
+  }();
+  const FrameSettings settings = Settings(a, scene);
+  if (!a.screenshot.empty()) {
+    PrintScreenshot(a, scene, settings);
+    return;
+  }
+  WindowOptions options;
+  if (!a.size.empty()) std::tie(options.width, options.height) = ParseSize(a.size);
+  options.fov_deg = a.fov_deg;
+  options.azimuth_deg = a.orbit_deg.value_or(30);
+  options.elevation_deg = a.elevation_deg;
+  const std::vector<double> light = ParseNumbers(a.light, 2, "--light");
+  options.light_azimuth_deg = light[0];
+  options.light_elevation_deg = light[1];
+  options.screenshot_dir = a.screenshot_dir;
+  options.motion_hold_ms = a.motion_hold_ms;
+  RunViewerWindow(scene, settings, options, SourceIndex(scene, a.camera),
+                  [](const std::string& text) {
+                    std::fputs(text.c_str(), stdout);
+                    std::fflush(stdout);
+                  });
+}
+
 }  // namespace
 
 void RegisterViewCommand(CLI::App& app) {
@@ -130,87 +226,10 @@ void RegisterViewCommand(CLI::App& app) {
   command->add_option("workspace", a->workspace, "workspace folder (mesh/mesh.obj and/or fused.ply, sparse/)")
       ->required();
   command->add_option("--screenshot", a->screenshot, "render offscreen into this PNG and exit");
-  auto* camera = command->add_option("--camera", a->camera, "view from this source camera (image name or stem)");
-  command->add_option("--orbit", a->orbit_deg, "view from an orbit about the scene at this azimuth (degrees); it looks where the source cameras look, "
-                 "from as far, when they surround the scene")
-      ->excludes(camera);
-  command->add_option("--elevation", a->elevation_deg,
-                      "orbit elevation above the ground (degrees; default: the source cameras' when they "
-                      "surround the scene, else 30)");
-  command->add_option("--fov", a->fov_deg, "orbit camera's horizontal field of view (degrees, default 50)")
-      ->check(CLI::Range(1.0, 170.0));
-  command->add_option("--size", a->size, "image size WxH (default 1280x720; a source camera's own size)");
-  command->add_option("--shadows", a->shadows,
-                      "auto|none|blob|planar|map|pcf|volume (default auto: none for projected photos, "
-                      "volume for a mesh of up to 4000 triangles, else pcf; it says which)")
-      ->transform(CLI::IsMember({"auto", "none", "blob", "planar", "map", "pcf", "volume"}, CLI::ignore_case));
-  const std::map<std::string, TextureMode> textures{{"atlas", TextureMode::kAtlas},
-                                                    {"projective", TextureMode::kProjective},
-                                                    {"shaded", TextureMode::kShaded},
-                                                    {"matcap", TextureMode::kMatcap}};
-  command->add_option("--texture", a->texture, "atlas|projective|shaded|matcap (default atlas; matcap: the atlas with a sphere-map specular)")
-      ->transform(CLI::CheckedTransformer(textures, CLI::ignore_case));
-  command->add_option("--light", a->light, "directional light azimuth,elevation in degrees (default 45,50)");
-  command->add_option("--point-light", a->point_light, "a point light at x,y,z (world) instead");
-  command->add_option("--exposure", a->settings.exposure_stops, "exposure in stops (default 0)");
-  const std::map<std::string, ToneMap> tone_maps{
-      {"clamp", ToneMap::kClamp}, {"reinhard", ToneMap::kReinhard}, {"aces", ToneMap::kAces}};
-  command->add_option("--tone-map", a->settings.tone_map,
-                      "clamp|reinhard|aces: how linear light becomes display values (default clamp: values over 1 "
-                      "clip; reinhard and aces render into a float frame first)")
-      ->transform(CLI::CheckedTransformer(tone_maps, CLI::ignore_case));
-  command->add_option("--white", a->settings.white, "reinhard: the exposed value shown as white (default 4)")
-      ->check(CLI::Range(1.0, 1e6));
-  command->add_flag("--auto-exposure", a->settings.auto_exposure,
-                    "expose each frame for its log-average luminance (mid grey 0.18), tone-mapped; in the window "
-                    "the eye adapts over half a second");
-  command->add_option("--light-intensity", a->settings.light.intensity,
-                      "the light's irradiance, linear (default 1; a point light's at the scene's centre)")
-      ->check(CLI::Range(0.0, 1e6));
-  command->add_option("--shadow-map-size", a->settings.shadow_map_size, "shadow map side in texels (default 2048)")
-      ->check(CLI::Range(64, 8192));
-  command->add_option("--pcf-radius", a->settings.pcf_radius, "PCF kernel radius in texels (default 1)")
-      ->check(CLI::Range(0, 4));
-  command->add_option("--time-frames", a->timed_frames,
-                      "with --screenshot: draw this many more frames and print the median frame time")
-      ->check(CLI::Range(1, 10000));
-  command->add_flag("--shadow-iou", a->shadow_iou,
-                    "with --screenshot: compare its shadow mask with one ray-traced by Embree for the same "
-                    "mesh and light, and print the intersection over union");
-  command->add_option("--screenshot-dir", a->screenshot_dir,
-                      "in the window: where the S key writes view-<n>.png (default: the current folder)");
-  command->add_option("--motion-hold-ms", a->motion_hold_ms,
-                      "in the window: how long after a drag or a light move frames are drawn at half "
-                      "resolution, to keep the motion smooth (default 200; 0: always full resolution)")
-      ->check(CLI::Range(0.0, 60000.0));
-  command->add_flag("--no-cameras", a->no_cameras, "hide the source cameras");
-  command->add_flag("--no-grid", a->no_grid, "hide the ground grid");
-  command->callback([a] {
-    const ViewerScene scene = [&] {
-      const WorkspaceLock lock(a->workspace, LockMode::kShared, "view");  // While it reads.
-      return LoadViewerScene(ViewerScenePathsFor(a->workspace));
-    }();
-    const FrameSettings settings = Settings(*a, scene);
-    if (!a->screenshot.empty()) {
-      PrintScreenshot(*a, scene, settings);
-      return;
-    }
-    WindowOptions options;
-    if (!a->size.empty()) std::tie(options.width, options.height) = ParseSize(a->size);
-    options.fov_deg = a->fov_deg;
-    options.azimuth_deg = a->orbit_deg.value_or(30);
-    options.elevation_deg = a->elevation_deg;
-    const std::vector<double> light = ParseNumbers(a->light, 2, "--light");
-    options.light_azimuth_deg = light[0];
-    options.light_elevation_deg = light[1];
-    options.screenshot_dir = a->screenshot_dir;
-    options.motion_hold_ms = a->motion_hold_ms;
-    RunViewerWindow(scene, settings, options, SourceIndex(scene, a->camera),
-                    [](const std::string& text) {
-                      std::fputs(text.c_str(), stdout);
-                      std::fflush(stdout);
-                    });
-  });
+  AddViewpointOptions(*command, *a);
+  AddLookOptions(*command, *a);
+  AddScreenshotAndWindowOptions(*command, *a);
+  command->callback([a] { RunView(*a); });
 }
 
 }  // namespace parallax
