@@ -144,7 +144,9 @@ void AddLookOptions(CLI::App& command, ViewArguments& a) {
                                                     {"projective", TextureMode::kProjective},
                                                     {"shaded", TextureMode::kShaded},
                                                     {"matcap", TextureMode::kMatcap}};
-  command.add_option("--texture", a.texture, "atlas|projective|shaded|matcap (default atlas; matcap: the atlas with a sphere-map specular)")
+  command.add_option("--texture", a.texture,
+                     "atlas|projective|shaded|matcap (default atlas; matcap: the atlas with a sphere-map "
+                     "specular)")
       ->transform(CLI::CheckedTransformer(textures, CLI::ignore_case));
   command.add_option("--light", a.light, "directional light azimuth,elevation in degrees (default 45,50)");
   command.add_option("--point-light", a.point_light, "a point light at x,y,z (world) instead");

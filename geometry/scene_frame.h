@@ -94,8 +94,9 @@ std::optional<CameraRig> FitCameraRig(const std::vector<FrameCamera>& cameras, c
 SceneFrame FitSceneFrame(const TriangleMesh& mesh, const std::vector<Eigen::Vector3f>& cloud,
                          const std::vector<FrameCamera>& cameras);
 
-// What a scene's frame is fitted to, read from its SceneFiles (core/scene_folder.h): each part empty where its file
-// does not exist (a scene folder has neither: its cameras alone make the frame).
+// What a scene's frame is fitted to, read from its SceneFiles (core/scene_folder.h): each part
+// empty where its file does not exist (a scene folder has neither: its cameras alone make the
+// frame).
 struct SceneGeometry {
   TriangleMesh mesh;
   TriangleMesh cloud;  // Positions, with normals and colours where the file has them.
