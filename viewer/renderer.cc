@@ -1,7 +1,6 @@
 #include "viewer/renderer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <span>
 #include <string_view>
@@ -153,10 +152,6 @@ void SceneRenderer::Impl::NoteOnce(const std::string& note) {
   if (std::find(notes_given.begin(), notes_given.end(), note) != notes_given.end()) return;
   notes_given.push_back(note);
   notes.push_back(note);
-}
-
-double SteadySeconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 SceneRenderer::SceneRenderer(const ViewerScene& scene, FrameClock clock)

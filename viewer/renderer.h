@@ -17,13 +17,11 @@
 
 #include <Eigen/Core>
 
+#include "core/elapsed.h"
 #include "viewer/frame.h"
 #include "viewer/viewer_scene.h"
 
 namespace parallax {
-
-// std::chrono::steady_clock's time in seconds: the renderer's clock unless it is given another.
-double SteadySeconds();
 
 class SceneRenderer {
  public:
