@@ -42,12 +42,12 @@ struct WorkspaceDepthPreparation {
 // Makes `library` prepare each workspace source's estimated depth map as it is loaded: specks
 // removed (RemoveDepthSpeckles: patches under 1/2000 of the photo, which would float in the sky
 // and be smeared into streaks by the fill), then, with DepthHoles::kMesh and the workspace's
-// mesh (`mesh`, an OBJ) present, the depth-0 pixels the mesh covers take its depth (Embree, one
+// mesh (`obj`) present, the depth-0 pixels the mesh covers take its depth (Embree, one
 // ray per pixel): estimated depth maps lack depth where matching failed; last, edge_erosion_px
 // pixels of the near side of every depth edge are dropped (ErodeDepthEdges): window-based
 // stereo fattens occluders, and their edge pixels mix in the background's color. Ground-truth
 // depth is used as it is.
-WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& mesh,
+WorkspaceDepthPreparation PrepareWorkspaceDepth(const std::filesystem::path& obj,
                                                 const NovelViewSettings& settings,
                                                 SourceLibrary* library);
 
