@@ -1,10 +1,11 @@
-# parallax_cpu_level: the instruction set of the render core (reproject/, which links it).
-# x86-64-v3 (AVX2, FMA, BMI2: every x86-64 CPU since about 2015) runs it ~15% faster than
-# baseline x86-64 (K=4 render at 640x480 16.1 -> 13.6 ms, bench/reproject_benchmark on a
-# 2-core AMD EPYC). AUTO uses it when the machine that builds parallax has it, so a build runs
-# where it is made; OFF builds for any x86-64 CPU (to copy the binaries to an older machine);
-# ON forces it. The rest of parallax stays baseline: `parallax synth` reproduces the committed
-# example scenes byte for byte only without fused multiply-adds.
+# parallax_cpu_level: the instruction set of the render core (reproject/) and of multi-view
+# stereo (mvs/), which link it. x86-64-v3 (AVX2, FMA, BMI2: every x86-64 CPU since about 2015)
+# runs the render core ~15% faster than baseline x86-64 (K=4 render at 640x480 16.1 -> 13.6
+# ms, bench/reproject_benchmark on a 2-core AMD EPYC), and PatchMatch's window cost takes eight
+# samples at a time (mvs/patch_match.cc). AUTO uses it when the machine that builds parallax
+# has it, so a build runs where it is made; OFF builds for any x86-64 CPU (to copy the binaries
+# to an older machine); ON forces it. The rest of parallax stays baseline: `parallax synth`
+# reproduces the committed example scenes byte for byte only without fused multiply-adds.
 set(PARALLAX_X86_64_V3 AUTO CACHE STRING
     "Compile the render core for x86-64-v3: AUTO (when this machine has it), ON or OFF")
 set_property(CACHE PARALLAX_X86_64_V3 PROPERTY STRINGS AUTO ON OFF)
@@ -33,5 +34,5 @@ if(parallax_use_v3)
   # baseline x86-64 that hand them over.
   target_compile_definitions(parallax_cpu_level INTERFACE EIGEN_MAX_STATIC_ALIGN_BYTES=16)
 endif()
-message(STATUS "parallax: render core compiled for x86-64-v3: ${parallax_use_v3} "
+message(STATUS "parallax: render core and stereo compiled for x86-64-v3: ${parallax_use_v3} "
                "(PARALLAX_X86_64_V3=${PARALLAX_X86_64_V3})")

@@ -6,6 +6,10 @@
 #include <numbers>
 #include <optional>
 
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -54,7 +58,11 @@ float Bilinear(const GrayImage& image, float u, float v) {
   return (1 - ay) * ((1 - ax) * row0[0] + ax * row0[1]) + ay * ((1 - ax) * row1[0] + ax * row1[1]);
 }
 
-// The sampling pattern of the matching window and its spatial weights.
+// The window's samples come in blocks of this many: the AVX2 cost takes eight at a time.
+constexpr int kSampleBlock = 8;
+
+// The sampling pattern of the matching window and its spatial weights, padded to whole
+// blocks with copies of the first sample of weight 0 (inside the source exactly when it is).
 struct WindowPattern {
   std::vector<float> dx, dy, spatial_weight;
   explicit WindowPattern(const PatchMatchOptions& options) {
@@ -66,6 +74,11 @@ struct WindowPattern {
         spatial_weight.push_back(
             std::exp(-r2 / (2 * options.sigma_spatial_px * options.sigma_spatial_px)));
       }
+    }
+    while (dx.size() % kSampleBlock != 0) {
+      dx.push_back(dx[0]);
+      dy.push_back(dy[0]);
+      spatial_weight.push_back(0);
     }
   }
   int Size() const { return static_cast<int>(dx.size()); }
@@ -143,10 +156,19 @@ struct SourceProjection {
   float max_u, max_v;  // Bilinear lookups need u < width - 1 after the -0.5 shift.
 };
 
-// 1 - NCC of one source for a homography, given the reference window.
-float SourceCost(const SourceProjection& source, const Eigen::Matrix3f& h, float px, float py,
-                 const ReferenceWindow& reference, const WindowPattern& pattern,
-                 float min_std) {
+// 1 - NCC from the weighted sums over the window of J, J^2 and I J (weights summing to 1).
+float CostFromSums(float sum_j, float sum_jj, float sum_ij, const ReferenceWindow& reference,
+                   float min_std) {
+  const float variance = sum_jj - sum_j * sum_j;
+  if (!(variance > min_std * min_std)) return kInvalidCost;
+  const float ncc = (sum_ij - reference.mean * sum_j) / (reference.stddev * std::sqrt(variance));
+  return 1 - std::clamp(ncc, -1.0f, 1.0f);
+}
+
+// 1 - NCC of one source for a homography, given the reference window: one sample at a time.
+float SourceCostPortable(const SourceProjection& source, const Eigen::Matrix3f& h, float px,
+                         float py, const ReferenceWindow& reference, const WindowPattern& pattern,
+                         float min_std) {
   const Eigen::Vector3f h0 = h * Eigen::Vector3f(px, py, 1);
   const Eigen::Vector3f hx = h.col(0), hy = h.col(1);
   float sum_j = 0, sum_jj = 0, sum_ij = 0;
@@ -161,10 +183,92 @@ float SourceCost(const SourceProjection& source, const Eigen::Matrix3f& h, float
     sum_jj += reference.weights[k] * j * j;
     sum_ij += reference.weighted_values[k] * j;
   }
-  const float variance = sum_jj - sum_j * sum_j;
-  if (!(variance > min_std * min_std)) return kInvalidCost;
-  const float ncc = (sum_ij - reference.mean * sum_j) / (reference.stddev * std::sqrt(variance));
-  return 1 - std::clamp(ncc, -1.0f, 1.0f);
+  return CostFromSums(sum_j, sum_jj, sum_ij, reference, min_std);
+}
+
+#if defined(__AVX2__) && defined(__FMA__)
+// The sum of the eight lanes.
+float HorizontalSum(__m256 v) {
+  const __m128 four = _mm_add_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  const __m128 two = _mm_add_ps(four, _mm_movehl_ps(four, four));
+  return _mm_cvtss_f32(_mm_add_ss(two, _mm_movehdup_ps(two)));
+}
+
+// For eight offsets into `values`, the float at each and the one after it: lane k of `left` is
+// values[offsets[k]], of `right` values[offsets[k] + 1]. Eight 8-byte loads and two shuffles,
+// faster than two gathers on AMD's Zen 3; inlined, or the call spills every vector.
+[[gnu::always_inline]] inline void LoadPairs(const float* values, const int32_t* offsets,
+                                             __m256* left, __m256* right) {
+  const auto two_pairs = [&](int a, int b) {  // [a, a + 1, b, b + 1]
+    const __m128 low = _mm_castpd_ps(_mm_load_sd(reinterpret_cast<const double*>(values + offsets[a])));
+    return _mm_loadh_pi(low, reinterpret_cast<const __m64*>(values + offsets[b]));
+  };
+  // Lanes 0-3 from samples 0-3, lanes 4-7 from samples 4-7: _mm256_shuffle_ps stays within them.
+  const __m256 even = _mm256_set_m128(two_pairs(4, 5), two_pairs(0, 1));
+  const __m256 odd = _mm256_set_m128(two_pairs(6, 7), two_pairs(2, 3));
+  *left = _mm256_shuffle_ps(even, odd, _MM_SHUFFLE(2, 0, 2, 0));
+  *right = _mm256_shuffle_ps(even, odd, _MM_SHUFFLE(3, 1, 3, 1));
+}
+
+// SourceCostPortable eight samples at a time (a block of the pattern); the same arithmetic,
+// rounded in another order.
+float SourceCostAvx2(const SourceProjection& source, const Eigen::Matrix3f& h, float px, float py,
+                     const ReferenceWindow& reference, const WindowPattern& pattern,
+                     float min_std) {
+  const Eigen::Vector3f h0 = h * Eigen::Vector3f(px, py, 1);
+  // Row r of the projection of sample (dx, dy): h0[r] + dx h(r, 0) + dy h(r, 1).
+  const auto project = [&](int r, __m256 dx, __m256 dy) {
+    return _mm256_fmadd_ps(dy, _mm256_set1_ps(h(r, 1)),
+                           _mm256_fmadd_ps(dx, _mm256_set1_ps(h(r, 0)), _mm256_set1_ps(h0[r])));
+  };
+  const float* values = source.image->values.data();
+  const int width = source.image->width;
+  const __m256 half = _mm256_set1_ps(0.5f), zero = _mm256_setzero_ps();
+  __m256 sum_j = zero, sum_jj = zero, sum_ij = zero;
+  for (int k = 0; k < pattern.Size(); k += kSampleBlock) {
+    const __m256 dx = _mm256_loadu_ps(&pattern.dx[k]), dy = _mm256_loadu_ps(&pattern.dy[k]);
+    const __m256 z = project(2, dx, dy);
+    if (_mm256_movemask_ps(_mm256_cmp_ps(z, _mm256_set1_ps(1e-6f), _CMP_GT_OQ)) != 0xff) {
+      return kInvalidCost;
+    }
+    const __m256 u = _mm256_sub_ps(_mm256_div_ps(project(0, dx, dy), z), half);
+    const __m256 v = _mm256_sub_ps(_mm256_div_ps(project(1, dx, dy), z), half);
+    const __m256 inside = _mm256_and_ps(
+        _mm256_and_ps(_mm256_cmp_ps(u, zero, _CMP_GE_OQ), _mm256_cmp_ps(v, zero, _CMP_GE_OQ)),
+        _mm256_and_ps(_mm256_cmp_ps(u, _mm256_set1_ps(source.max_u), _CMP_LT_OQ),
+                      _mm256_cmp_ps(v, _mm256_set1_ps(source.max_v), _CMP_LT_OQ)));
+    if (_mm256_movemask_ps(inside) != 0xff) return kInvalidCost;
+    const __m256i x0 = _mm256_cvttps_epi32(u), y0 = _mm256_cvttps_epi32(v);  // u, v >= 0.
+    const __m256 ax = _mm256_sub_ps(u, _mm256_cvtepi32_ps(x0));
+    const __m256 ay = _mm256_sub_ps(v, _mm256_cvtepi32_ps(y0));
+    alignas(32) int32_t offsets[kSampleBlock];  // Of the top-left corners of the lookups.
+    _mm256_store_si256(reinterpret_cast<__m256i*>(offsets),
+                       _mm256_add_epi32(_mm256_mullo_epi32(y0, _mm256_set1_epi32(width)), x0));
+    __m256 j00, j01, j10, j11;
+    LoadPairs(values, offsets, &j00, &j01);
+    LoadPairs(values + width, offsets, &j10, &j11);
+    const __m256 top = _mm256_fmadd_ps(ax, _mm256_sub_ps(j01, j00), j00);
+    const __m256 bottom = _mm256_fmadd_ps(ax, _mm256_sub_ps(j11, j10), j10);
+    const __m256 j = _mm256_fmadd_ps(ay, _mm256_sub_ps(bottom, top), top);
+    const __m256 weighted_j = _mm256_mul_ps(_mm256_loadu_ps(&reference.weights[k]), j);
+    sum_j = _mm256_add_ps(sum_j, weighted_j);
+    sum_jj = _mm256_fmadd_ps(weighted_j, j, sum_jj);
+    sum_ij = _mm256_fmadd_ps(_mm256_loadu_ps(&reference.weighted_values[k]), j, sum_ij);
+  }
+  return CostFromSums(HorizontalSum(sum_j), HorizontalSum(sum_jj), HorizontalSum(sum_ij),
+                      reference, min_std);
+}
+#endif
+
+float SourceCost(const SourceProjection& source, const Eigen::Matrix3f& h, float px, float py,
+                 const ReferenceWindow& reference, const WindowPattern& pattern, float min_std,
+                 [[maybe_unused]] CostKernel kernel = CostKernel::kFastest) {
+#if defined(__AVX2__) && defined(__FMA__)
+  if (kernel == CostKernel::kFastest) {
+    return SourceCostAvx2(source, h, px, py, reference, pattern, min_std);
+  }
+#endif
+  return SourceCostPortable(source, h, px, py, reference, pattern, min_std);
 }
 
 class PatchMatcher {
@@ -430,7 +534,8 @@ Eigen::Matrix3d PlaneHomography(const Camera& reference, const Camera& source,
 }
 
 float WindowCost(const GrayImage& reference, int x, int y, const GrayImage& source,
-                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options) {
+                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options,
+                 CostKernel kernel) {
   const WindowPattern pattern(options);
   const ReferenceWindows windows(reference, pattern, options);
   const ReferenceWindow window = windows.At(x, y);
@@ -438,7 +543,7 @@ float WindowCost(const GrayImage& reference, int x, int y, const GrayImage& sour
   const SourceProjection projection{&source, {}, {}, static_cast<float>(source.width - 1),
                                     static_cast<float>(source.height - 1)};
   return SourceCost(projection, homography.cast<float>(), static_cast<float>(x) + 0.5f,
-                    static_cast<float>(y) + 0.5f, window, pattern, options.min_texture_std);
+                    static_cast<float>(y) + 0.5f, window, pattern, options.min_texture_std, kernel);
 }
 
 double InverseDepthSample(double min_depth, double max_depth, double fraction) {

@@ -85,11 +85,17 @@ Eigen::Matrix3d PlaneHomography(const Camera& reference, const Camera& source,
                                 const Rigid3d& source_from_reference, const Eigen::Vector3d& normal,
                                 double rho);
 
+// The implementations of the window cost: the fastest this build has (eight samples at a time
+// where mvs/ is compiled for x86-64-v3, cmake/cpu_level.cmake) and the portable one, one
+// sample at a time, which tests compare it with.
+enum class CostKernel { kFastest, kPortable };
+
 // Bilaterally weighted NCC cost 1 - NCC in [0, 2] between the reference window around
 // (x, y) and the source window the homography maps it to; 2 when the source window leaves the
 // image or either window is textureless.
 float WindowCost(const GrayImage& reference, int x, int y, const GrayImage& source,
-                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options);
+                 const Eigen::Matrix3d& homography, const PatchMatchOptions& options,
+                 CostKernel kernel = CostKernel::kFastest);
 
 // Depth `fraction` of the way from min to max depth, linear in inverse depth.
 double InverseDepthSample(double min_depth, double max_depth, double fraction);

@@ -11,6 +11,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -22,6 +23,12 @@
 #include "tests/stability/float_reference.h"
 
 namespace parallax {
+
+// "fastest" or "portable": in the tests' names and their reports.
+void PrintTo(CostKernel kernel, std::ostream* out) {
+  *out << (kernel == CostKernel::kFastest ? "fastest" : "portable");
+}
+
 namespace {
 
 using stability_test::kEps;
@@ -132,13 +139,16 @@ Eigen::Matrix3d RandomNearIdentity(double centre, std::mt19937& random) {
   return back * warp * about;
 }
 
-TEST(FloatReference, WindowCostAgreesWithCentredDoubleMomentsWithinItsConditioning) {
+class WindowCostKernels : public testing::TestWithParam<CostKernel> {};
+
+TEST_P(WindowCostKernels, AgreeWithCentredDoubleMomentsWithinTheirConditioning) {
   // WindowCost computes variances and the covariance as E[I^2] - E[I]^2 in float: each
   // cancels catastrophically when the mean is large against the contrast, losing a factor
   // kappa = (mean^2 + var) / var. Windows of mean 0.05..0.95 and contrast down to the texture
   // threshold (std 0.004, so kappa up to ~5e4) meet a randomly warped, relit source.
   // Bound: |cost error| <= 16 kEps kappa: 16 samples, each adding a rounding of its products
-  // to the sums before the cancellation, which then divides by var.
+  // to the sums before the cancellation, which then divides by var. Both kernels (eight
+  // samples at a time, and one) are held to it.
   std::mt19937 random(21);
   std::uniform_real_distribution<double> unit(0, 1);
   const PatchMatchOptions options;
@@ -161,7 +171,7 @@ TEST(FloatReference, WindowCostAgreesWithCentredDoubleMomentsWithinItsConditioni
     bool near_threshold = false;
     const double expected =
         ReferenceCost(reference, kSize / 2, kSize / 2, source, h, options, &kappa, &near_threshold);
-    const double actual = WindowCost(reference, kSize / 2, kSize / 2, source, h, options);
+    const double actual = WindowCost(reference, kSize / 2, kSize / 2, source, h, options, GetParam());
     ASSERT_TRUE(std::isfinite(actual));
     if (near_threshold) {
       ++skipped;
@@ -174,10 +184,16 @@ TEST(FloatReference, WindowCostAgreesWithCentredDoubleMomentsWithinItsConditioni
     EXPECT_LE(error, 16 * kEps * kappa)
         << "kappa " << kappa << " expected " << expected << " got " << actual;
   }
-  Report("window_cost_worst_abs_error", worst, 0);
-  Report("window_cost_worst_error_over_eps_kappa", worst_scaled, 16);
+  const std::string kernel = testing::PrintToString(GetParam());
+  Report("window_cost_" + kernel + "_worst_abs_error", worst, 0);
+  Report("window_cost_" + kernel + "_worst_error_over_eps_kappa", worst_scaled, 16);
   EXPECT_GT(compared, 2700) << skipped << " near a threshold";
 }
+INSTANTIATE_TEST_SUITE_P(FloatReference, WindowCostKernels,
+                         testing::Values(CostKernel::kFastest, CostKernel::kPortable),
+                         [](const testing::TestParamInfo<CostKernel>& kernel) {
+                           return testing::PrintToString(kernel.param);
+                         });
 
 // ---- Forward warp: a source pixel with depth reprojected into the target (float) ----------
 
