@@ -142,6 +142,9 @@ void AddDenseOptions(CLI::App& command, ReconstructArguments& arguments) {
                      "cap on the long side of the depth estimate, in pixels (default: as --quality says)")
       ->check(CLI::Range(64, 100000))
       ->excludes(scale);
+  command.add_option("--mvs-seed", arguments.options.mvs_seed,
+                     "seed of the depth stage's random search (default 0): runs with other seeds "
+                     "measure the run-to-run spread of the depth and of what is built from it");
   command.add_flag("--no-mesh", arguments.no_mesh, "stop after depth maps and the fused cloud (no textured mesh)");
 }
 

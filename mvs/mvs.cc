@@ -182,7 +182,7 @@ DepthNormalMap EstimateViewDepth(const ViewPlan& plan, const std::map<uint32_t, 
   PatchMatchOptions patch_match = options.patch_match;
   patch_match.min_depth = plan.min_depth;
   patch_match.max_depth = plan.max_depth;
-  patch_match.seed = plan.image_id;
+  patch_match.seed = plan.image_id + options.seed;
   return PatchMatchStereo(views.at(plan.image_id), sources, patch_match);
 }
 

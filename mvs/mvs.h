@@ -25,7 +25,7 @@ namespace parallax {
 
 struct MvsOptions {
   ViewSelectionOptions views;
-  PatchMatchOptions patch_match;  // Its depth range is set per view from the sparse points.
+  PatchMatchOptions patch_match;  // Its depth range and seed are set per view.
   GeometricFilterOptions filter;
   // Only these views (image names) get depth maps; empty means every view. Their first
   // `filter_sources` source views are estimated too (photometric only, not written), since
@@ -40,6 +40,8 @@ struct MvsOptions {
   // keeps that resolution, and so what they mean, alike for photos of any size.
   double image_scale = 1;
   int max_image_size = 0;
+  // Each view's PatchMatch seed is its image id plus this.
+  uint32_t seed = 0;
   // The share of each side a width x height photo is estimated at.
   double ScaleFor(int width, int height) const;
   void Check() const;

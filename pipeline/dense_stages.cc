@@ -51,6 +51,7 @@ DepthRequest DepthRequestOf(const ReconstructOptions& options) {
   request.sources = options.mvs_sources;
   request.scale = options.mvs_scale;
   request.max_size = options.mvs_max_size;
+  request.seed = options.mvs_seed;
   return request;
 }
 
@@ -63,6 +64,7 @@ MvsOptions MvsOptionsOf(const DepthRequest& request) {
   }
   if (request.max_size > 0) options.max_image_size = request.max_size;
   options.only_views = request.views;
+  options.seed = request.seed;
   return options;
 }
 
@@ -97,6 +99,8 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
       .Add(static_cast<uint64_t>(request.stereo))
       .Add(static_cast<uint64_t>(request.sources))
       .Add(ScaleKey(workspace, MvsOptionsOf(request)));
+  // Seed 0 adds nothing: workspaces estimated before the seed was an option keep their maps.
+  if (request.seed != 0) hasher.Add("seed").Add(static_cast<uint64_t>(request.seed));
   for (const std::string& view : request.views) hasher.Add(view);
   Stage stage;
   stage.name = "depth";

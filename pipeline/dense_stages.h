@@ -2,6 +2,7 @@
 // The dense stages as data (pipeline/stage_graph.h): depth (multi-view stereo), fusion and
 // the textured mesh, each keyed by the stage before it. `reconstruct` asks for depth of every
 // view; `render` asks the same stage for the views its cameras use.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@ struct DepthRequest {
   // long-side cap says. A scale alone lifts the cap (scale 1 is the photo's full size).
   double scale = 0;
   int max_size = 0;
+  uint32_t seed = 0;  // MvsOptions::seed.
   // Only these views (image names); empty: every view, and depth/views.json is written.
   std::vector<std::string> views;
   // The views were estimated in blocks by other processes (RunMultiViewStereoBlock,
@@ -34,7 +36,7 @@ struct DepthRequest {
 // The depth `reconstruct` asks for with `options`.
 DepthRequest DepthRequestOf(const ReconstructOptions& options);
 // As <ws>/slurm/depth_request.json keeps it for the cluster's jobs (pipeline/slurm.h).
-NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DepthRequest, quality, stereo, sources, scale, max_size)
+NLOHMANN_DEFINE_TYPE_NON_INTRUSIVE_WITH_DEFAULT(DepthRequest, quality, stereo, sources, scale, max_size, seed)
 
 // The stereo's options for `request`.
 MvsOptions MvsOptionsOf(const DepthRequest& request);

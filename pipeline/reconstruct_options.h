@@ -1,6 +1,7 @@
 #pragma once
 // What `parallax reconstruct` is asked for (ReconstructOptions), shared by the stages that
 // carry it out (pipeline/sfm_stages.h, dense_stages.h, slurm.h) and their policy.
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -105,6 +106,9 @@ struct ReconstructOptions {
   // At most one of the two is set.
   double mvs_scale = 0;
   int mvs_max_size = 0;
+  // Seeds PatchMatch's random search: each view's seed is its image id plus this. Runs with
+  // other seeds measure the run-to-run spread of the depth and of what is built from it.
+  uint32_t mvs_seed = 0;
   // After depth: Poisson mesh, trimmed and textured (the mesh stage, pipeline/dense_stages.h).
   bool build_mesh = true;
   void Check() const;  // Throws UsageError naming the field.

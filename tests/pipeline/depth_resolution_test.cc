@@ -61,5 +61,17 @@ TEST(DepthResolution, TheKeyFollowsTheWorkingSizeNotTheKnobs) {
   EXPECT_NE(DepthKey(large, half), DepthKey(large, fast)) << "same size, other quality";
 }
 
+TEST(DepthResolution, AnotherSeedIsAnotherEstimateAndSeedZeroKeepsTheOldKey) {
+  const TempDir folder;
+  const Workspace workspace(folder.Path());
+  WriteModel(workspace, 640, 480);
+  DepthRequest reseeded;
+  reseeded.seed = 7;
+  EXPECT_EQ(MvsOptionsOf(reseeded).seed, 7u);
+  EXPECT_NE(DepthKey(workspace, reseeded), DepthKey(workspace, {}));
+  // The key of seed 0, as it was before seeds could be chosen (fixed here, computed once).
+  EXPECT_EQ(DepthKey(workspace, {}), "098e236f2c42c63c");
+}
+
 }  // namespace
 }  // namespace parallax
