@@ -1,6 +1,7 @@
 #include "core/atomic_file.h"
 
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <system_error>
 #include <cerrno>
@@ -126,9 +127,11 @@ std::string ReadFileBytes(const fs::path& path) {
   if (fs::is_directory(path, error)) throw BadInputError(path.string() + " is a folder, not a file");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw BadInputError("cannot open " + path.string());
-  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  // Whole buffers at a time: an istreambuf_iterator copies byte by byte, ~10x slower.
+  std::ostringstream bytes;
+  bytes << file.rdbuf();
   if (file.bad()) throw BadInputError("cannot read " + path.string());
-  return bytes;
+  return std::move(bytes).str();
 }
 
 }  // namespace parallax
