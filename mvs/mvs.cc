@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
+#include <tbb/parallel_for.h>
 
 #include "core/error.h"
 #include "core/check.h"
@@ -106,11 +107,11 @@ MvsOptions MvsOptionsFor(Quality quality) {
 
 DepthMap ToColmapSampling(const DepthMap& depth) {
   DepthMap sampled(depth.Width(), depth.Height());
-  for (int y = 0; y < depth.Height(); ++y) {
+  tbb::parallel_for(0, depth.Height(), [&](int y) {
     for (int x = 0; x < depth.Width(); ++x) {
       sampled.At(x, y) = static_cast<float>(SampleDepth(depth, Eigen::Vector2d(x, y), 1.01).value_or(0));
     }
-  }
+  });
   return sampled;
 }
 
