@@ -91,7 +91,7 @@ MvsOptions MvsOptionsFor(Quality quality) {
     case Quality::kFast:
       options.views.max_sources = 3;
       options.patch_match.iterations = 2;
-      options.patch_match.far_neighbour_offset = 0;
+      options.patch_match.propagation_reach = 1;
       break;
     case Quality::kBalanced:
       break;

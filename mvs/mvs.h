@@ -47,8 +47,8 @@ struct MvsOptions {
   void Check() const;
 };
 
-// fast: 3 sources, 4x4-sample window, 2 iterations, near neighbours only;
-// balanced: 5 sources, 4x4 samples, 3 iterations, near and far neighbours;
+// fast: 3 sources, 4x4-sample window, 2 iterations, adjacent neighbours only;
+// balanced: 5 sources, 4x4 samples, 3 iterations, neighbours up to 5 px away;
 // best: 7 sources, 4 iterations. Long side capped at MaxImageSizeFor(quality) (docs/depth.md).
 MvsOptions MvsOptionsFor(Quality quality);
 

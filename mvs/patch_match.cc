@@ -437,17 +437,28 @@ class PatchMatcher {
         best = candidate;
       }
     };
-    // Propagation: the neighbours' planes (of the other color), extended to this pixel.
-    const int far = options_.far_neighbour_offset;
-    const std::array<std::pair<int, int>, 8> offsets = {
-        {{-1, 0}, {1, 0}, {0, -1}, {0, 1}, {-far, 0}, {far, 0}, {0, -far}, {0, far}}};
+    // Propagation: in each direction, the plane of the neighbour of the other color (an odd
+    // number of pixels away, up to the reach) that fits its own pixel best, extended to this
+    // one. One candidate a direction, the most promising of several, as ACMH (Xu and Tao,
+    // CVPR 2019) chooses its own.
+    const std::array<std::pair<int, int>, 4> directions = {{{-1, 0}, {1, 0}, {0, -1}, {0, 1}}};
     const Eigen::Vector3f ray = Ray(x, y);
-    for (int k = 0; k < (far > 0 ? 8 : 4); ++k) {
-      const int nx = x + offsets[k].first, ny = y + offsets[k].second;
-      if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) continue;
-      const Plane neighbour = StoredPlane(nx, ny);
-      if (!(neighbour.depth > 0)) continue;
-      const float rho = neighbour.depth * neighbour.normal.dot(Ray(nx, ny));
+    for (const auto& [dx, dy] : directions) {
+      int chosen_x = -1, chosen_y = -1;
+      float chosen_cost = 0;
+      for (int step = 1; step <= options_.propagation_reach; step += 2) {
+        const int nx = x + step * dx, ny = y + step * dy;
+        if (nx < 0 || ny < 0 || nx >= width_ || ny >= height_) break;
+        const size_t i = Index(nx, ny);
+        if (result_.depth.Values()[i] > 0 && (chosen_x < 0 || result_.cost[i] < chosen_cost)) {
+          chosen_x = nx;
+          chosen_y = ny;
+          chosen_cost = result_.cost[i];
+        }
+      }
+      if (chosen_x < 0) continue;
+      const Plane neighbour = StoredPlane(chosen_x, chosen_y);
+      const float rho = neighbour.depth * neighbour.normal.dot(Ray(chosen_x, chosen_y));
       consider({rho / neighbour.normal.dot(ray), neighbour.normal});
     }
     // Random refinement, narrowing with each iteration; plus one fresh random guess.
@@ -508,9 +519,8 @@ void PatchMatchOptions::Check() const {
                 "[1, window_radius]");
   RequireOption(iterations >= 0, "PatchMatchOptions.iterations", iterations, ">= 0");
   RequireOption(pyramid_levels >= 1 && pyramid_levels <= 6, "PatchMatchOptions.pyramid_levels", pyramid_levels, "[1, 6]");
-  RequireOption(far_neighbour_offset >= 0 && (far_neighbour_offset % 2 == 1 || far_neighbour_offset == 0),
-                "PatchMatchOptions.far_neighbour_offset", far_neighbour_offset,
-                "0 or odd (red-black propagation)");
+  RequireOption(propagation_reach >= 1 && propagation_reach % 2 == 1, "PatchMatchOptions.propagation_reach",
+                propagation_reach, "odd and >= 1 (red-black propagation)");
   RequireOption(sigma_color > 0, "PatchMatchOptions.sigma_color", sigma_color, "> 0");
   RequireOption(sigma_spatial_px > 0, "PatchMatchOptions.sigma_spatial_px", sigma_spatial_px, "> 0");
   RequireOption(best_views >= 1, "PatchMatchOptions.best_views", best_views, ">= 1");

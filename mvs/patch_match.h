@@ -40,9 +40,10 @@ struct PatchMatchOptions {
   int iterations = 3;
   // Coarse-to-fine levels (each half the size of the next); 1 = full resolution only.
   int pyramid_levels = 3;
-  // Propagate from the 4 adjacent pixels, and also from 4 pixels `far_neighbour_offset` away
-  // (0 disables the far ones).
-  int far_neighbour_offset = 3;
+  // Propagation takes one plane from each of the 4 directions: that of the neighbour with the
+  // lowest cost among those 1, 3, ... up to `propagation_reach` pixels away (1: the adjacent
+  // one).
+  int propagation_reach = 5;
   // Bilateral weights: intensity difference scale (intensities in [0, 1]) and spatial scale
   // in pixels.
   float sigma_color = 0.12f;
