@@ -9,6 +9,8 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "core/atomic_file.h"
 #include "core/depth_map.h"
@@ -94,29 +96,47 @@ void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const st
   progress.Update("depth", total, total);
 }
 
-// The view's maps in both formats (COLMAP's under <ws>/stereo, EXR under <ws>/depth).
+// The view's maps in both formats (COLMAP's under <ws>/stereo, EXR under <ws>/depth), the six
+// files made and written side by side.
 void WriteViewDepth(const Workspace& ws, const ViewDepth& view) {
   const std::string& name = view.report.name;
-  WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kPhotometric), ToColmapSampling(view.estimate.depth));
-  WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kGeometric), ToColmapSampling(view.filtered.depth));
-  WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kPhotometric),
-                   ColmapNormalMap(view.estimate, view.estimate.depth));
-  WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kGeometric),
-                   ColmapNormalMap(view.estimate, view.filtered.depth));
-  WriteDepthExr(ws.Depth(name), view.filtered.depth);
-  WriteDepthExr(ws.DepthConfidence(name), view.filtered.confidence);
+  tbb::parallel_invoke(
+      [&] {
+        WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kPhotometric), ToColmapSampling(view.estimate.depth));
+      },
+      [&] {
+        WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kGeometric), ToColmapSampling(view.filtered.depth));
+      },
+      [&] {
+        WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kPhotometric),
+                         ColmapNormalMap(view.estimate, view.estimate.depth));
+      },
+      [&] {
+        WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kGeometric),
+                         ColmapNormalMap(view.estimate, view.filtered.depth));
+      },
+      [&] { WriteDepthExr(ws.Depth(name), view.filtered.depth); },
+      [&] { WriteDepthExr(ws.DepthConfidence(name), view.filtered.confidence); });
 }
 
 // The geometric pass for one view: its estimate checked against those of its sources in
 // `estimated` (read back from <ws>/stereo/estimates), written in both formats.
 MvsViewReport FilterAndWriteView(const Workspace& ws, const SparseModel& model, const ViewPlan& view,
                                  const std::set<std::string>& estimated, const MvsOptions& options) {
-  std::map<uint32_t, DepthNormalMap> source_estimates;
+  // The estimates of the sources that have one, and the view's own (last), read side by side.
+  std::vector<uint32_t> ids;
+  std::vector<std::string> names;
   for (const uint32_t id : view.sources) {
-    const std::string& name = model.ImageById(id).name;
-    if (estimated.count(name)) source_estimates[id] = ReadEstimate(ws.StereoEstimate(name));
+    if (!estimated.count(model.ImageById(id).name)) continue;
+    ids.push_back(id);
+    names.push_back(model.ImageById(id).name);
   }
-  const DepthNormalMap low = ReadEstimate(ws.StereoEstimate(view.name));
+  names.push_back(view.name);
+  std::vector<DepthNormalMap> read(names.size());
+  tbb::parallel_for(size_t{0}, names.size(), [&](size_t i) { read[i] = ReadEstimate(ws.StereoEstimate(names[i])); });
+  std::map<uint32_t, DepthNormalMap> source_estimates;
+  for (size_t i = 0; i < ids.size(); ++i) source_estimates[ids[i]] = std::move(read[i]);
+  const DepthNormalMap& low = read.back();
   const ViewDepth depth = FilterViewDepth(model, view, low, source_estimates, options);
   WriteViewDepth(ws, depth);
   return depth.report;
