@@ -462,7 +462,7 @@ class PatchMatcher {
       consider({rho / neighbour.normal.dot(ray), neighbour.normal});
     }
     // Random refinement, narrowing with each iteration; plus one fresh random guess.
-    const float amplitude = std::pow(0.5f, static_cast<float>(iteration + 1));
+    const float amplitude = std::ldexp(1.0f, -(iteration + 1));  // 2^-(iteration + 1), exactly.
     const float inverse = 1 / best.depth + (Random(options_.seed, x, y, iteration, 20) - 0.5f) *
                                                amplitude * (inverse_max_ - inverse_min_);
     if (inverse > 0) consider({1 / inverse, best.normal});
