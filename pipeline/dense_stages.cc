@@ -99,7 +99,7 @@ Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,
       .Add(static_cast<uint64_t>(request.stereo))
       .Add(static_cast<uint64_t>(request.sources))
       .Add(ScaleKey(workspace, MvsOptionsOf(request)));
-  // Seed 0 adds nothing: workspaces estimated before the seed was an option keep their maps.
+  // Seed 0 adds nothing: the default keeps the key it had before a seed could be chosen.
   if (request.seed != 0) hasher.Add("seed").Add(static_cast<uint64_t>(request.seed));
   for (const std::string& view : request.views) hasher.Add(view);
   Stage stage;
