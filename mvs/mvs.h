@@ -48,7 +48,7 @@ struct MvsOptions {
 };
 
 // fast: 3 sources, 4x4-sample window, 2 iterations, adjacent neighbours only;
-// balanced: 5 sources, 4x4 samples, 3 iterations, neighbours up to 5 px away;
+// balanced: 5 sources, 4x4 samples, 3 iterations, neighbours up to 7 px away;
 // best: 7 sources, 4 iterations. Long side capped at MaxImageSizeFor(quality) (docs/depth.md).
 MvsOptions MvsOptionsFor(Quality quality);
 

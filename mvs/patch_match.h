@@ -43,7 +43,7 @@ struct PatchMatchOptions {
   // Propagation takes one plane from each of the 4 directions: that of the neighbour with the
   // lowest cost among those 1, 3, ... up to `propagation_reach` pixels away (1: the adjacent
   // one).
-  int propagation_reach = 5;
+  int propagation_reach = 7;
   // Bilateral weights: intensity difference scale (intensities in [0, 1]) and spatial scale
   // in pixels.
   float sigma_color = 0.12f;

@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 namespace {
 
 // Bump when a stage's results change for the same options, so caches recompute.
-constexpr const char* kMvsVersion = "patch-match-7";
+constexpr const char* kMvsVersion = "patch-match-8";
 constexpr const char* kFusionVersion = "fusion-6";
 constexpr const char* kMeshVersion = "mesh-9";
 constexpr const char* kColorGainsVersion = "color-gains-1";
