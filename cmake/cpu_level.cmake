@@ -7,7 +7,7 @@
 # to an older machine); ON forces it. The rest of parallax stays baseline: `parallax synth`
 # reproduces the committed example scenes byte for byte only without fused multiply-adds.
 set(PARALLAX_X86_64_V3 AUTO CACHE STRING
-    "Compile the render core for x86-64-v3: AUTO (when this machine has it), ON or OFF")
+    "Compile the render core and stereo for x86-64-v3: AUTO (when this machine has it), ON or OFF")
 set_property(CACHE PARALLAX_X86_64_V3 PROPERTY STRINGS AUTO ON OFF)
 
 include(CheckCXXCompilerFlag)
