@@ -100,23 +100,16 @@ void EstimatePhotometric(const Workspace& ws, const SparseModel& model, const st
 // files made and written side by side.
 void WriteViewDepth(const Workspace& ws, const ViewDepth& view) {
   const std::string& name = view.report.name;
-  tbb::parallel_invoke(
-      [&] {
-        WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kPhotometric), ToColmapSampling(view.estimate.depth));
-      },
-      [&] {
-        WriteColmapDepth(ws.StereoDepthMap(name, StereoPass::kGeometric), ToColmapSampling(view.filtered.depth));
-      },
-      [&] {
-        WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kPhotometric),
-                         ColmapNormalMap(view.estimate, view.estimate.depth));
-      },
-      [&] {
-        WriteColmapArray(ws.StereoNormalMap(name, StereoPass::kGeometric),
-                         ColmapNormalMap(view.estimate, view.filtered.depth));
-      },
-      [&] { WriteDepthExr(ws.Depth(name), view.filtered.depth); },
-      [&] { WriteDepthExr(ws.DepthConfidence(name), view.filtered.confidence); });
+  // One pass's COLMAP depth and normal maps, where `kept` has depth.
+  const auto write_colmap_pass = [&](StereoPass pass, const DepthMap& kept) {
+    tbb::parallel_invoke(
+        [&] { WriteColmapDepth(ws.StereoDepthMap(name, pass), ToColmapSampling(kept)); },
+        [&] { WriteColmapArray(ws.StereoNormalMap(name, pass), ColmapNormalMap(view.estimate, kept)); });
+  };
+  tbb::parallel_invoke([&] { write_colmap_pass(StereoPass::kPhotometric, view.estimate.depth); },
+                       [&] { write_colmap_pass(StereoPass::kGeometric, view.filtered.depth); },
+                       [&] { WriteDepthExr(ws.Depth(name), view.filtered.depth); },
+                       [&] { WriteDepthExr(ws.DepthConfidence(name), view.filtered.confidence); });
 }
 
 // The geometric pass for one view: its estimate checked against those of its sources in
