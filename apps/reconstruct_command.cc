@@ -135,8 +135,8 @@ void AddDenseOptions(CLI::App& command, ReconstructArguments& arguments) {
   CLI::Option* scale = command.add_option(
       "--mvs-scale", arguments.options.mvs_scale,
       "resolution of the depth estimate as a share of each photo side, no cap (1: full size; "
-      "default: as --quality caps the long side: 768, 1024, 1600 px; depth maps are always "
-      "written at the photo's size)");
+      "default: as --quality caps the long side: 768, 1024, 1600 px; depth maps are written at "
+      "that resolution and read back at the photo's size)");
   scale->check(CLI::Range(0.25, 1.0));
   command.add_option("--mvs-max-size", arguments.options.mvs_max_size,
                      "cap on the long side of the depth estimate, in pixels (default: as --quality says)")

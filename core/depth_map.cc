@@ -117,6 +117,41 @@ DepthMap ReadDepthExr(const fs::path& path) {
   return depth;
 }
 
+std::vector<size_t> PixelsAtCentres(int grid_width, int grid_height, int width, int height) {
+  std::vector<size_t> indices;
+  indices.reserve(static_cast<size_t>(width) * static_cast<size_t>(height));
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) indices.push_back(PixelAtCentre(grid_width, grid_height, width, height, x, y));
+  }
+  return indices;
+}
+
+size_t PixelAtCentre(int grid_width, int grid_height, int width, int height, int x, int y) {
+  const int gx = std::min(grid_width - 1, static_cast<int>((x + 0.5) * grid_width / width));
+  const int gy = std::min(grid_height - 1, static_cast<int>((y + 0.5) * grid_height / height));
+  return static_cast<size_t>(gy) * static_cast<size_t>(grid_width) + static_cast<size_t>(gx);
+}
+
+DepthMap UpsampleNearest(const DepthMap& depth, int width, int height) {
+  if (depth.Width() == width && depth.Height() == height) return depth;
+  const std::vector<size_t> nearest = PixelsAtCentres(depth.Width(), depth.Height(), width, height);
+  DepthMap full(width, height);
+  for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
+  return full;
+}
+
+DepthMap ReadDepthExrAt(const fs::path& path, int width, int height) {
+  DepthMap depth = ReadDepthExr(path);
+  // A working size of the photo: no larger, and each side scaled alike (to a pixel's rounding).
+  const double scale = static_cast<double>(depth.Width()) / width;
+  if (depth.Width() > width || depth.Height() > height || std::abs(scale * height - depth.Height()) > 1) {
+    throw BadInputError("depth " + path.string() + " is " + std::to_string(depth.Width()) + "x" +
+                        std::to_string(depth.Height()) + ": neither its photo's size (" + std::to_string(width) +
+                        "x" + std::to_string(height) + ") nor a smaller one of its shape");
+  }
+  return UpsampleNearest(depth, width, height);
+}
+
 void WriteDepthExr(const fs::path& path, const DepthMap& depth) {
   CheckWrittenDepth(depth, path);
   WriteAtomically(path, [&](const fs::path& temporary) {

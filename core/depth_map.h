@@ -44,6 +44,18 @@ class DepthMap {
 std::optional<double> SampleDepth(const DepthMap& depth, const Eigen::Vector2d& pixel,
                                   double max_ratio);
 
+// For each pixel of a width x height image (row-major), the index of the pixel of a
+// grid_width x grid_height map over the same area that its centre falls in: how a map made at
+// a lower resolution (the depth stage's working size) is read at the photo's size (nearest,
+// never blending depths across an edge), and how fusion picks its working pixels.
+std::vector<size_t> PixelsAtCentres(int grid_width, int grid_height, int width, int height);
+// The same for the one pixel (x, y).
+size_t PixelAtCentre(int grid_width, int grid_height, int width, int height, int x, int y);
+
+// `depth` at width x height: itself when it has that size, else each pixel holds the value of
+// the map's pixel its centre falls in (PixelsAtCentres).
+DepthMap UpsampleNearest(const DepthMap& depth, int width, int height);
+
 // A COLMAP dense array: `channels` planes of width x height floats, channel-major.
 struct DenseArray {
   int width = 0;
@@ -56,6 +68,10 @@ struct DenseArray {
 // Throws BadInputError naming the file for a missing/corrupt file, several channels, negative
 // values, NaN or Inf.
 DepthMap ReadDepthExr(const std::filesystem::path& path);
+// A depth EXR read at a photo's width x height: the depth stage writes its maps at its working
+// size, which may be smaller; they are upsampled nearest (UpsampleNearest). Throws
+// BadInputError naming the file when the map is larger than the photo or of another shape.
+DepthMap ReadDepthExrAt(const std::filesystem::path& path, int width, int height);
 // Writes one float32 channel named "Z", ZIP-compressed (lossless), atomically. Throws
 // InternalError for negative, NaN or Inf values.
 void WriteDepthExr(const std::filesystem::path& path, const DepthMap& depth);

@@ -63,7 +63,8 @@ class Workspace {
   // A part of the raw model adjusted apart (the principal point's check, pipeline/sfm_policy.h).
   std::filesystem::path PartialModelScratch() const { return Sfm() / "partial.tmp"; }
 
-  // Depth maps at each photo's size: depth/<stem>.exr and depth/<stem>.confidence.exr.
+  // Depth maps at the depth stage's working size (ReadDepthExrAt reads them at the photo's):
+  // depth/<stem>.exr and depth/<stem>.confidence.exr.
   std::filesystem::path DepthDir() const { return root_ / "depth"; }
   std::filesystem::path Depth(const std::string& photo) const;
   std::filesystem::path DepthConfidence(const std::string& photo) const;

@@ -165,7 +165,9 @@ ViewResult EvaluateView(const SparseModel& estimate_model, const SparseImage& es
                         const fs::path& error_image_dir) {
   const Camera& estimate_camera = ProjectableCamera(estimate_model, estimate_image);
   const Camera& truth_camera = ProjectableCamera(truth_model, truth_image);
-  const DepthMap estimate = ReadDepthForCamera(estimate_path, estimate_camera);
+  // The depth stage writes its maps at its working size: read at the photo's.
+  const DepthMap estimate = ReadDepthExrAt(estimate_path, static_cast<int>(estimate_camera.width),
+                                           static_cast<int>(estimate_camera.height));
   const DepthMap truth =
       ReadDepthForCamera(DepthPathFor(truth_depth_dir, truth_image.name), truth_camera);
 

@@ -134,11 +134,12 @@ class FusionViewCache {
     const DepthMap& depth = maps.depth;
     const DenseArray& normals = maps.normals;
     const Image& color = maps.color;
-    const int width = depth.Width(), height = depth.Height();
-    if (width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height) ||
-        normals.width != width || normals.height != height || normals.channels != 3 || color.Width() != width ||
-        color.Height() != height) {
-      throw BadInputError("fusion: depth, normal map, image and camera of " + image.name + " differ in size");
+    const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+    const int map_width = depth.Width(), map_height = depth.Height();
+    if (map_width > width || map_height > height || normals.width != map_width || normals.height != map_height ||
+        normals.channels != 3 || color.Width() != width || color.Height() != height) {
+      throw BadInputError("fusion: the depth and normal maps of " + image.name +
+                          " differ in size or are larger than its image and camera");
     }
     FusionView view;
     view.camera = FusionCamera(camera, options_);
@@ -146,14 +147,19 @@ class FusionViewCache {
     view.world_from_cam = image.cam_from_world.rotation.conjugate().toRotationMatrix();
     const int working_width = static_cast<int>(view.camera.width);
     const int working_height = static_cast<int>(view.camera.height);
-    // The maps were upsampled by nearest neighbour: these pixels hold the estimates as they were.
+    // Each working pixel reads the maps where the photo's pixel its centre falls in reads
+    // them: the maps may be smaller than the photo (the depth stage's working size), and are
+    // read at it as ReadDepthExrAt upsamples them, nearest.
     const std::vector<size_t> fine = PixelsAtCentres(width, height, working_width, working_height);
-    const size_t fine_pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    const size_t map_pixels = static_cast<size_t>(map_width) * static_cast<size_t>(map_height);
     view.depth = DepthMap(working_width, working_height);
     view.normals = {working_width, working_height, 3, std::vector<float>(3 * fine.size())};
     for (size_t i = 0; i < fine.size(); ++i) {
-      view.depth.Values()[i] = depth.Values()[fine[i]];
-      for (size_t c = 0; c < 3; ++c) view.normals.values[c * fine.size() + i] = normals.values[c * fine_pixels + fine[i]];
+      const int x = static_cast<int>(fine[i] % static_cast<size_t>(width));
+      const int y = static_cast<int>(fine[i] / static_cast<size_t>(width));
+      const size_t in_map = PixelAtCentre(map_width, map_height, width, height, x, y);
+      view.depth.Values()[i] = depth.Values()[in_map];
+      for (size_t c = 0; c < 3; ++c) view.normals.values[c * fine.size() + i] = normals.values[c * map_pixels + in_map];
     }
     view.color = ResampleArea(SrgbToLinear(color), working_width, working_height);
     ApplyGain(maps.gain, view.color);

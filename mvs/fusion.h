@@ -38,8 +38,8 @@ struct FusionOptions {
   // this many; only they are in memory with it, so memory does not grow with the photo count.
   int max_neighbours = 8;
   // The resolution views are fused at (mvs/working_resolution.h): the depth stage's, since its
-  // maps hold no more detail at the photo's size; memory and points then follow the working
-  // size, not the photo's megapixels. Colors are area-averaged down to it.
+  // maps hold no more detail; memory and points then follow the working size, not the photo's
+  // megapixels. Colors are area-averaged down to it.
   double image_scale = 1;
   int max_image_size = 0;
   void Check() const;
@@ -56,10 +56,11 @@ struct FusedPoint {
 // would (it then holds the old and the new array, up to three times the points, at once).
 using FusedPoints = std::deque<FusedPoint>;
 
-// What fusion reads of one view, each at the photo's size.
+// What fusion reads of one view: the photo at its size, the maps at the depth stage's working
+// size or the photo's.
 struct FusionViewMaps {
   DepthMap depth;           // The filtered depth map.
-  DenseArray normals;       // The geometric normal map: camera frame, COLMAP's layout.
+  DenseArray normals;       // The geometric normal map (as large): camera frame, COLMAP's layout.
   Image color;              // The photo as read (sRGB).
   RgbGain gain{1, 1, 1};    // The photo's color gain, applied at the working resolution.
 };
@@ -69,8 +70,9 @@ using LoadFusionView = std::function<FusionViewMaps(const SparseImage& image)>;
 
 // Fuses `views` (images of `model`, each with a depth and a normal map), streamed: at most
 // max_neighbours + 1 views in memory, each at the working resolution. Neighbours are found from
-// the model's 3D points. Throws BadInputError when a view's maps, photo and camera differ in
-// size (and what `load` throws). Deterministic.
+// the model's 3D points. Throws BadInputError when a view's photo and camera differ in size,
+// its depth and normal maps differ or are larger than the photo (and what `load` throws).
+// Deterministic.
 FusedPoints FuseDepthMaps(const SparseModel& model, const std::vector<const SparseImage*>& views,
                           const LoadFusionView& load, const FusionOptions& options, Progress& progress);
 

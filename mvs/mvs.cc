@@ -36,23 +36,6 @@ GrayImage ResampleTo(const GrayImage& image, const Camera& camera) {
   return {width, height, std::vector<float>(small.begin<float>(), small.end<float>())};
 }
 
-DepthMap UpsampleNearest(const DepthMap& depth, const std::vector<size_t>& nearest, int width, int height) {
-  DepthMap full(width, height);
-  for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
-  return full;
-}
-
-DepthNormalMap UpsampleNearest(const DepthNormalMap& estimate, const std::vector<size_t>& nearest, int width,
-                               int height) {
-  DepthNormalMap full{UpsampleNearest(estimate.depth, nearest, width, height),
-                      std::vector<float>(3 * nearest.size()), std::vector<float>(estimate.cost.empty() ? 0 : nearest.size())};
-  for (size_t i = 0; i < nearest.size(); ++i) {
-    if (!estimate.cost.empty()) full.cost[i] = estimate.cost[nearest[i]];
-    for (size_t c = 0; c < 3; ++c) full.normal[3 * i + c] = estimate.normal[3 * nearest[i] + c];
-  }
-  return full;
-}
-
 double ValidShare(const DepthMap& depth) {
   size_t valid = 0;
   for (const float value : depth.Values()) valid += value > 0;
@@ -187,27 +170,6 @@ DepthNormalMap EstimateViewDepth(const ViewPlan& plan, const std::map<uint32_t, 
   return PatchMatchStereo(views.at(plan.image_id), sources, patch_match);
 }
 
-namespace {
-
-// `low` and `filtered` (working resolution) at the photo's size, as ViewDepth holds them; sets
-// the report's shares of pixels with depth.
-ViewDepth AtPhotoSize(const Camera& camera, const DepthNormalMap& low, FilteredDepth filtered, MvsViewReport report) {
-  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
-  const bool same_size = low.depth.Width() == width && low.depth.Height() == height;
-  const std::vector<size_t> nearest =
-      same_size ? std::vector<size_t>() : PixelsAtCentres(low.depth.Width(), low.depth.Height(), width, height);
-  ViewDepth view{same_size ? low : UpsampleNearest(low, nearest, width, height), std::move(filtered), std::move(report)};
-  if (!same_size) {
-    view.filtered.depth = UpsampleNearest(view.filtered.depth, nearest, width, height);
-    view.filtered.confidence = UpsampleNearest(view.filtered.confidence, nearest, width, height);
-  }
-  view.report.photometric_share = ValidShare(view.estimate.depth);
-  view.report.geometric_share = ValidShare(view.filtered.depth);
-  return view;
-}
-
-}  // namespace
-
 ViewDepth FilterViewDepth(const SparseModel& model, const ViewPlan& view, const DepthNormalMap& low,
                           const std::map<uint32_t, DepthNormalMap>& source_estimates, const MvsOptions& options) {
   const auto working_view = [&](uint32_t id) { return WorkingStereoView(model, model.ImageById(id), options); };
@@ -232,8 +194,9 @@ ViewDepth FilterViewDepth(const SparseModel& model, const ViewPlan& view, const 
   report.max_depth = view.max_depth;
   report.working_width = low.depth.Width();
   report.working_height = low.depth.Height();
-  const Camera& camera = model.CameraById(model.ImageById(view.image_id).camera_id);
-  return AtPhotoSize(camera, low, std::move(filtered), std::move(report));
+  report.photometric_share = ValidShare(low.depth);
+  report.geometric_share = ValidShare(filtered.depth);
+  return {low, std::move(filtered), std::move(report)};
 }
 
 }  // namespace parallax

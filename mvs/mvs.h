@@ -1,9 +1,9 @@
 #pragma once
 // Multi-view stereo, one view at a time, on cameras and photos in memory: which views get depth
 // (PlanDepth), PatchMatch of one view against its sources at the working resolution
-// (EstimateViewDepth), then the geometric-consistency filter against the sources' estimates and
-// the maps at the photo's size (FilterViewDepth). The depth stage that runs this over a
-// workspace, reads its photos and writes its dense files is pipeline/depth_workspace.h.
+// (EstimateViewDepth), then the geometric-consistency filter against the sources' estimates
+// (FilterViewDepth). The depth stage that runs this over a workspace, reads its photos and
+// writes its dense files is pipeline/depth_workspace.h.
 #include <cstdint>
 #include <map>
 #include <set>
@@ -34,10 +34,11 @@ struct MvsOptions {
   int filter_sources = 2;
   // The working resolution of the estimate: each photo is resampled to `image_scale` of each
   // side (0.25..1), and further so that its long side is at most `max_image_size` pixels (0:
-  // no cap). The depth maps are upsampled back (nearest, never blending depths across an
-  // edge) so every file keeps the photo's size. The pixel-valued options above (windows,
-  // propagation offsets, reprojection tolerances, gap sizes) are in working pixels; a cap
-  // keeps that resolution, and so what they mean, alike for photos of any size.
+  // no cap). The maps stay at that size, in memory and in their files; readers upsample them
+  // to the photo's (ReadDepthExrAt: nearest, never blending depths across an edge). The
+  // pixel-valued options above (windows, propagation offsets, reprojection tolerances, gap
+  // sizes) are in working pixels; a cap keeps that resolution, and so what they mean, alike
+  // for photos of any size.
   double image_scale = 1;
   int max_image_size = 0;
   // Each view's PatchMatch seed is its image id plus this.
@@ -115,8 +116,7 @@ GrayImage WorkingGray(const Image& photo, const Camera& camera);
 DepthNormalMap EstimateViewDepth(const ViewPlan& plan, const std::map<uint32_t, StereoView>& views,
                                  const MvsOptions& options);
 
-// One view's depth after both passes, at the photo's size whatever the working resolution
-// (upsampled nearest, never blending depths across an edge).
+// One view's depth after both passes, at the working resolution.
 struct ViewDepth {
   DepthNormalMap estimate;  // The photometric estimate.
   FilteredDepth filtered;   // What the geometric filter kept, and its confidence.

@@ -21,17 +21,4 @@ Camera WorkingCamera(const Camera& camera, double scale) {
                            camera.PrincipalX() * sx, camera.PrincipalY() * sy);
 }
 
-std::vector<size_t> PixelsAtCentres(int grid_width, int grid_height, int width, int height) {
-  std::vector<size_t> indices;
-  indices.reserve(static_cast<size_t>(width) * static_cast<size_t>(height));
-  for (int y = 0; y < height; ++y) {
-    const int gy = std::min(grid_height - 1, static_cast<int>((y + 0.5) * grid_height / height));
-    for (int x = 0; x < width; ++x) {
-      const int gx = std::min(grid_width - 1, static_cast<int>((x + 0.5) * grid_width / width));
-      indices.push_back(static_cast<size_t>(gy) * static_cast<size_t>(grid_width) + static_cast<size_t>(gx));
-    }
-  }
-  return indices;
-}
-
 }  // namespace parallax

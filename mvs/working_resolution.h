@@ -2,9 +2,6 @@
 // The resolution the stereo works at, shared by the depth stage and fusion: each photo is
 // resampled to `image_scale` of each side, and further so that its long side is at most
 // `max_image_size` pixels (0: no cap).
-#include <cstddef>
-#include <vector>
-
 #include "core/camera.h"
 
 namespace parallax {
@@ -15,10 +12,5 @@ double WorkingScale(int width, int height, double image_scale, int max_image_siz
 // The camera of a photo resampled to `scale` of its size: pixel coordinates (origin at the
 // image corner) scale by the exact size ratio per axis.
 Camera WorkingCamera(const Camera& camera, double scale);
-
-// For each pixel of a width x height image (row-major), the index of the pixel of a
-// grid_width x grid_height image over the same area that its centre falls in: how the depth
-// stage upsamples its maps (nearest, never blending depths), and how fusion reads them back.
-std::vector<size_t> PixelsAtCentres(int grid_width, int grid_height, int width, int height);
 
 }  // namespace parallax

@@ -87,7 +87,7 @@ std::string DescribeDepthResolution(const DepthRequest& request, int width, int 
   std::snprintf(share, sizeof share, "%.3g", scale);
   return "depth at " + side(width) + "x" + side(height) + " for " + std::to_string(width) + "x" +
          std::to_string(height) + " photos (scale " + share + "): " + why +
-         (scale < 1 ? "; depth maps are written at the photo's size" : "");
+         (scale < 1 ? "; depth maps are written at that size and read at the photo's" : "");
 }
 
 Stage DepthStage(const Workspace& workspace, const std::string& undistort_key,

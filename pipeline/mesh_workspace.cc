@@ -42,8 +42,10 @@ std::vector<SupportView> LoadSupportViews(const Workspace& workspace, const Spar
   for (const SparseImage& image : model.Images()) {
     const fs::path depth = workspace.Depth(image.name);
     if (!fs::exists(depth)) continue;
+    const Camera& camera = model.CameraById(image.camera_id);
+    const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
     views.push_back(
-        {model.CameraById(image.camera_id), image.cam_from_world, [depth] { return ReadDepthExr(depth); }});
+        {camera, image.cam_from_world, [depth, width, height] { return ReadDepthExrAt(depth, width, height); }});
   }
   return views;
 }

@@ -250,10 +250,7 @@ const SourceView& SourceLibrary::Load(int index, const ForwardWarpOptions& warp)
     if (view->color.Channels() != 3) {
       throw BadInputError((paths_.images / name).string() + ": expected an RGB image");
     }
-    view->depth = ReadDepthExr(paths_.DepthFor(name));
-    if (view->depth.Width() != view->color.Width() || view->depth.Height() != view->color.Height()) {
-      throw BadInputError(paths_.DepthFor(name).string() + ": depth map and photo differ in size");
-    }
+    view->depth = ReadDepthExrAt(paths_.DepthFor(name), view->color.Width(), view->color.Height());
     if (preparation_) prepared_pixels_ += preparation_(view.get());
     loaded_pixels_ += static_cast<long>(view->depth.Values().size());
     PrepareSource(view.get(), warp, gains_.Of(name));

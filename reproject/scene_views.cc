@@ -46,7 +46,7 @@ std::vector<SourceView> ReadSourceViews(const ViewSetPaths& paths) {
     view.camera = cameras[i].camera;
     view.cam_from_world = cameras[i].cam_from_world;
     view.color = LinearRgb(ReadImage(paths.images / names[i]));
-    view.depth = ReadDepthExr(paths.DepthFor(names[i]));
+    view.depth = ReadDepthExrAt(paths.DepthFor(names[i]), view.color.Width(), view.color.Height());
     PrepareSource(&view);
     views.push_back(std::move(view));
   }

@@ -36,8 +36,7 @@ double Cell(const std::string& csv, const std::string& row_prefix, const std::st
   return -1;
 }
 
-// The width the depth stage of a bench workspace estimated its first view at (its maps are
-// written at the photo's size whatever the working resolution).
+// The width the depth stage of a bench workspace estimated its first view at.
 int WorkingWidth(const fs::path& workspace) {
   const nlohmann::json report = nlohmann::json::parse(ReadFileBytes(Workspace(workspace).Report()));
   return report.at("reconstruct").at("depth").at("views").at(0).at("working_width").get<int>();

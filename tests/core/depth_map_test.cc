@@ -47,6 +47,34 @@ TEST(DepthMap, ExrReaderAcceptsAnySingleChannelName) {
   EXPECT_THROW(ReadDepthExr(dir.Path() / "rgb.exr"), BadInputError);
 }
 
+// A map at the depth stage's working size is read at its photo's, each pixel holding the value
+// of the map's pixel its centre falls in; a map larger than the photo, or of another shape, is
+// an error naming the file.
+TEST(DepthMap, WorkingSizeMapsAreReadAtThePhotosSizeNearest) {
+  const TempDir dir;
+  const DepthMap small = MakeDepth(20, 13);  // 0.667 of 30x20, as a 1024 cap makes 1536x1024.
+  WriteDepthExr(dir.Path() / "d.exr", small);
+  const DepthMap full = ReadDepthExrAt(dir.Path() / "d.exr", 30, 20);
+  ASSERT_EQ(full.Width(), 30);
+  ASSERT_EQ(full.Height(), 20);
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 30; ++x) {
+      // The centre (x + 0.5, y + 0.5) scaled by 20/30 and 13/20.
+      const int sx = static_cast<int>((x + 0.5) * 20 / 30), sy = static_cast<int>((y + 0.5) * 13 / 20);
+      ASSERT_EQ(full.At(x, y), small.At(sx, sy)) << x << "," << y;
+    }
+  }
+  EXPECT_EQ(ReadDepthExrAt(dir.Path() / "d.exr", 20, 13).Values(), small.Values());
+  for (const auto& [width, height] : {std::pair{19, 13}, std::pair{30, 30}, std::pair{20, 12}}) {
+    try {
+      ReadDepthExrAt(dir.Path() / "d.exr", width, height);
+      ADD_FAILURE() << "a 20x13 map read at " << width << "x" << height;
+    } catch (const BadInputError& error) {
+      EXPECT_NE(std::string(error.what()).find("d.exr is 20x13"), std::string::npos) << error.what();
+    }
+  }
+}
+
 TEST(DepthMap, ColmapDenseLayoutIsChannelMajorWithAsciiHeader) {
   const TempDir dir;
   DenseArray normals{3, 2, 3, {}};

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <OpenImageIO/imagebuf.h>
 
 #include "core/atomic_file.h"
+#include "core/color_gains.h"
 #include "core/depth_map.h"
 #include "core/error.h"
 #include "core/scene_folder.h"
@@ -285,12 +287,50 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
   EXPECT_LT(sgbm.abs_rel_median, 0.01);
   EXPECT_LT(sgbm.within_2pct, depth.within_2pct);
 
-  // Half resolution: the maps keep the photos' size, lose some accuracy, stay unbiased.
+  // Half resolution: the maps are written at half the photos' size (evaluate reads them at the
+  // photos'), lose some accuracy, stay unbiased.
   MvsOptions half = MvsOptionsFor(Quality::kBalanced);
   half.image_scale = 0.5;
   RunMultiViewStereo(Workspace(workspace.Path()), half, "half scale", progress);
-  EXPECT_EQ(ReadDepthExr(Workspace(workspace.Path()).Depth("0000.png")).Width(),
-            static_cast<int>(truth.Cameras().front().width));
+  const Camera& photo = truth.Cameras().front();
+  const DepthMap half_depth = ReadDepthExr(Workspace(workspace.Path()).Depth("0000.png"));
+  EXPECT_EQ(half_depth.Width(), std::lround(0.5 * static_cast<double>(photo.width)));
+  EXPECT_EQ(half_depth.Height(), std::lround(0.5 * static_cast<double>(photo.height)));
+  EXPECT_EQ(ReadColmapArray(Workspace(workspace.Path()).StereoNormalMap("0000.png", StereoPass::kGeometric)).width,
+            half_depth.Width());
+  // Fusion reads the half-size maps as if they were upsampled to the photos' size: the same cloud.
+  FusionOptions half_fusion;
+  half_fusion.image_scale = 0.5;
+  const FusedPoints from_working_size = FuseWorkspace(Workspace(workspace.Path()), half_fusion, progress);
+  const SparseModel sparse = ReadSparseModelWithoutKeypoints(Workspace(workspace.Path()).Sparse());
+  std::vector<const SparseImage*> fused_views;
+  for (const SparseImage& image : sparse.Images()) {
+    if (std::filesystem::exists(Workspace(workspace.Path()).Depth(image.name))) fused_views.push_back(&image);
+  }
+  const ColorGains gains = ReadWorkspaceColorGains(workspace.Path());
+  const LoadFusionView at_photo_size = [&](const SparseImage& image) {
+    const Workspace ws(workspace.Path());
+    const Camera& camera = sparse.CameraById(image.camera_id);
+    const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+    const DenseArray normals = ReadColmapArray(ws.StereoNormalMap(image.name, StereoPass::kGeometric));
+    const std::vector<size_t> nearest = PixelsAtCentres(normals.width, normals.height, width, height);
+    const size_t map_pixels = static_cast<size_t>(normals.width) * static_cast<size_t>(normals.height);
+    FusionViewMaps maps{ReadDepthExrAt(ws.Depth(image.name), width, height),
+                        {width, height, 3, std::vector<float>(3 * nearest.size())}, ReadImage(ws.Image(image.name)),
+                        gains.Of(image.name)};
+    for (size_t c = 0; c < 3; ++c) {
+      for (size_t i = 0; i < nearest.size(); ++i) {
+        maps.normals.values[c * nearest.size() + i] = normals.values[c * map_pixels + nearest[i]];
+      }
+    }
+    return maps;
+  };
+  const FusedPoints from_photo_size = FuseDepthMaps(sparse, fused_views, at_photo_size, half_fusion, progress);
+  ASSERT_EQ(from_working_size.size(), from_photo_size.size());
+  for (size_t i = 0; i < from_working_size.size(); ++i) {
+    ASSERT_EQ(from_working_size[i].position, from_photo_size[i].position) << i;
+    ASSERT_EQ(from_working_size[i].color, from_photo_size[i].color) << i;
+  }
   const DepthEvaluation coarse =
       EvaluateDepth(model, Workspace(workspace.Path()).DepthDir(), truth, scene.Training().depth, {}, {});
   std::printf("[ measure ] depth at half resolution: within 2%% %.3f (full %.3f), completeness %.3f\n",
