@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -258,17 +259,22 @@ TEST(DepthEvaluation, NearestOfSeveralEstimatesLandingInOnePixelCounts) {
   EXPECT_DOUBLE_EQ(evaluation.completeness, 1);
 }
 
+// A smaller map of the photo's shape is a working size, read at the photo's; one larger than
+// the photo or of another shape is an error.
 TEST(DepthEvaluation, DepthMapOfTheWrongSizeIsBadInputNamingTheFile) {
   const Fixture fixture;
   fixture.WriteEstimates(fixture.truth);
   const fs::path wrong = DepthFile(fixture.EstimateDir(), fixture.truth.Images()[1]);
-  WriteDepthExr(wrong, DepthMap(kWidth / 2, kHeight / 2));
-  try {
-    fixture.Evaluate(fixture.truth);
-    FAIL() << "expected BadInputError";
-  } catch (const BadInputError& error) {
-    EXPECT_NE(std::string(error.what()).find(wrong.string()), std::string::npos) << error.what();
-    EXPECT_NE(std::string(error.what()).find("32x24"), std::string::npos) << error.what();
+  for (const auto& [width, height, size] :
+       {std::tuple{kWidth / 2, kHeight, "32x48"}, std::tuple{kWidth * 2, kHeight * 2, "128x96"}}) {
+    WriteDepthExr(wrong, DepthMap(width, height));
+    try {
+      fixture.Evaluate(fixture.truth);
+      ADD_FAILURE() << "expected BadInputError for a " << size << " map";
+    } catch (const BadInputError& error) {
+      EXPECT_NE(std::string(error.what()).find(wrong.string()), std::string::npos) << error.what();
+      EXPECT_NE(std::string(error.what()).find(size), std::string::npos) << error.what();
+    }
   }
 }
 
