@@ -326,6 +326,7 @@ TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
     return maps;
   };
   const FusedPoints from_photo_size = FuseDepthMaps(sparse, fused_views, at_photo_size, half_fusion, progress);
+  ASSERT_GT(from_working_size.size(), 5000u);
   ASSERT_EQ(from_working_size.size(), from_photo_size.size());
   for (size_t i = 0; i < from_working_size.size(); ++i) {
     ASSERT_EQ(from_working_size[i].position, from_photo_size[i].position) << i;
