@@ -1,7 +1,9 @@
 #include "colmap/database.h"
 
+#include <cstring>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include <sqlite3.h>
 
@@ -11,25 +13,46 @@ namespace parallax {
 
 namespace {
 
+using Connection = std::unique_ptr<sqlite3, decltype(&sqlite3_close)>;
+using Statement = std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)>;
+
+// COLMAP's pair id: image_id1 * 2147483647 + image_id2, with image_id1 < image_id2.
+constexpr int64_t kMaxImageId = 2147483647;
+
+// Throws BadInputError naming the database, the action ("read", "write"), the step that failed and
+// SQLite's message.
+[[noreturn]] void Fail(const std::filesystem::path& database, sqlite3* connection, const char* what,
+                       const char* action = "read") {
+  throw BadInputError(std::string("cannot ") + action + " the COLMAP database " + database.string() +
+                      " (" + what + "): " + (connection ? sqlite3_errmsg(connection) : "out of memory"));
+}
+
+Connection Open(const std::filesystem::path& database, int flags, const char* action) {
+  sqlite3* raw = nullptr;
+  const int opened = sqlite3_open_v2(database.c_str(), &raw, flags, nullptr);
+  Connection connection(raw, &sqlite3_close);
+  if (opened != SQLITE_OK) Fail(database, raw, "open", action);
+  return connection;
+}
+
+Statement Prepare(const std::filesystem::path& database, sqlite3* connection, const char* query,
+                  const char* action) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(connection, query, -1, &raw, nullptr) != SQLITE_OK) {
+    Fail(database, connection, "query", action);
+  }
+  return Statement(raw, &sqlite3_finalize);
+}
+
 // Runs `query` on the database read-only, calling `row` for each result row. Throws
 // BadInputError naming the file if it cannot be opened, queried or read.
 void ForEachRow(const std::filesystem::path& database, const char* query,
                 const std::function<void(sqlite3_stmt*)>& row) {
-  sqlite3* raw = nullptr;
-  const int opened = sqlite3_open_v2(database.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
-  const std::unique_ptr<sqlite3, decltype(&sqlite3_close)> connection(raw, &sqlite3_close);
-  auto fail = [&](const char* what) {
-    throw BadInputError("cannot read the COLMAP database " + database.string() + " (" + what +
-                        "): " + (raw ? sqlite3_errmsg(raw) : "out of memory"));
-  };
-  if (opened != SQLITE_OK) fail("open");
-  sqlite3_stmt* raw_statement = nullptr;
-  if (sqlite3_prepare_v2(raw, query, -1, &raw_statement, nullptr) != SQLITE_OK) fail("query");
-  const std::unique_ptr<sqlite3_stmt, decltype(&sqlite3_finalize)> statement(raw_statement,
-                                                                             &sqlite3_finalize);
+  const Connection connection = Open(database, SQLITE_OPEN_READONLY, "read");
+  const Statement statement = Prepare(database, connection.get(), query, "read");
   int step;
-  while ((step = sqlite3_step(raw_statement)) == SQLITE_ROW) row(raw_statement);
-  if (step != SQLITE_DONE) fail("read");
+  while ((step = sqlite3_step(statement.get())) == SQLITE_ROW) row(statement.get());
+  if (step != SQLITE_DONE) Fail(database, connection.get(), "read");
 }
 
 std::string TextColumn(sqlite3_stmt* statement, int column) {
@@ -67,8 +90,6 @@ std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& databas
   ForEachRow(database, "SELECT image_id, name FROM images", [&](sqlite3_stmt* row) {
     names[sqlite3_column_int64(row, 0)] = TextColumn(row, 1);
   });
-  // COLMAP's pair id: image_id1 * 2147483647 + image_id2, with image_id1 < image_id2.
-  constexpr int64_t kMaxImageId = 2147483647;
   std::vector<VerifiedPair> pairs;
   ForEachRow(database, "SELECT pair_id, rows, config FROM two_view_geometries WHERE rows > 0",
              [&](sqlite3_stmt* row) {
@@ -80,6 +101,82 @@ std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& databas
                                                            : PairGeometry::kUndefined});
              });
   return pairs;
+}
+
+std::vector<DatabaseDescriptors> ReadDescriptors(const std::filesystem::path& database) {
+  std::vector<DatabaseDescriptors> images;
+  ForEachRow(database, "SELECT image_id, rows, cols, data FROM descriptors ORDER BY image_id",
+             [&](sqlite3_stmt* row) {
+               DatabaseDescriptors image;
+               image.image_id = static_cast<uint32_t>(sqlite3_column_int64(row, 0));
+               image.rows = sqlite3_column_int(row, 1);
+               const int columns = sqlite3_column_int(row, 2);
+               const auto* bytes = static_cast<const uint8_t*>(sqlite3_column_blob(row, 3));
+               const int64_t size = sqlite3_column_bytes(row, 3);
+               if (image.rows < 0 || (image.rows > 0 && columns != 128) ||
+                   size != int64_t{image.rows} * columns || (size > 0 && !bytes)) {
+                 throw BadInputError("the COLMAP database " + database.string() + " holds descriptors of image " +
+                                     std::to_string(image.image_id) + " that are not rows of 128 bytes (" +
+                                     std::to_string(image.rows) + " x " + std::to_string(columns) + ", " +
+                                     std::to_string(size) + " bytes)");
+               }
+               image.data.assign(bytes, bytes + size);
+               images.push_back(std::move(image));
+             });
+  return images;
+}
+
+std::vector<RawMatches> ReadRawMatches(const std::filesystem::path& database) {
+  std::vector<RawMatches> pairs;
+  ForEachRow(database, "SELECT pair_id, rows, cols, data FROM matches", [&](sqlite3_stmt* row) {
+    const int64_t pair_id = sqlite3_column_int64(row, 0);
+    const int64_t rows = sqlite3_column_int64(row, 1);
+    const void* blob = sqlite3_column_blob(row, 3);
+    if ((rows > 0 && sqlite3_column_int(row, 2) != 2) ||
+        sqlite3_column_bytes(row, 3) != rows * 2 * static_cast<int64_t>(sizeof(uint32_t))) {
+      throw BadInputError("the COLMAP database " + database.string() + " holds matches of pair " +
+                          std::to_string(pair_id) + " that are not rows of two indices");
+    }
+    RawMatches pair{static_cast<uint32_t>(pair_id / kMaxImageId), static_cast<uint32_t>(pair_id % kMaxImageId), {}};
+    pair.matches.resize(static_cast<size_t>(rows));
+    if (rows > 0) std::memcpy(pair.matches.data(), blob, pair.matches.size() * sizeof(pair.matches[0]));
+    pairs.push_back(std::move(pair));
+  });
+  return pairs;
+}
+
+void WriteRawMatches(const std::filesystem::path& database, const std::vector<RawMatches>& pairs) {
+  const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
+  auto execute = [&](const char* sql) {
+    if (sqlite3_exec(connection.get(), sql, nullptr, nullptr, nullptr) != SQLITE_OK) {
+      Fail(database, connection.get(), sql, "write");
+    }
+  };
+  execute("BEGIN");
+  {
+    const Statement insert =
+        Prepare(database, connection.get(),
+                "INSERT OR REPLACE INTO matches (pair_id, rows, cols, data) VALUES (?, ?, ?, ?)", "write");
+    for (const RawMatches& pair : pairs) {
+      const bool swap = pair.first_image_id > pair.second_image_id;
+      const int64_t low = swap ? pair.second_image_id : pair.first_image_id;
+      const int64_t high = swap ? pair.first_image_id : pair.second_image_id;
+      std::vector<uint32_t> columns;  // colmap's layout: rows of (low's feature, high's feature).
+      columns.reserve(2 * pair.matches.size());
+      for (const auto& match : pair.matches) {
+        columns.push_back(match[swap ? 1 : 0]);
+        columns.push_back(match[swap ? 0 : 1]);
+      }
+      sqlite3_stmt* statement = insert.get();
+      sqlite3_bind_int64(statement, 1, low * kMaxImageId + high);
+      sqlite3_bind_int64(statement, 2, static_cast<int64_t>(pair.matches.size()));
+      sqlite3_bind_int64(statement, 3, 2);
+      sqlite3_bind_blob64(statement, 4, columns.data(), columns.size() * sizeof(uint32_t), SQLITE_TRANSIENT);
+      if (sqlite3_step(statement) != SQLITE_DONE) Fail(database, connection.get(), "insert matches", "write");
+      sqlite3_reset(statement);
+    }
+  }
+  execute("COMMIT");
 }
 
 }  // namespace parallax

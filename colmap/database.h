@@ -3,6 +3,7 @@
 // (COLMAP's multi-threaded feature extractor assigns ids in the order images finish, not in
 // name order, so a model that must match the database (point_triangulator) takes its ids
 // from here), and how each matched pair was verified (to say why mapping could not start).
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -44,5 +45,33 @@ std::map<std::string, int> ReadFeatureCounts(const std::filesystem::path& databa
 // Every verified pair, in the database's order. Throws BadInputError naming the file if it
 // cannot be read.
 std::vector<VerifiedPair> ReadVerifiedPairs(const std::filesystem::path& database);
+
+// One image's SIFT descriptors: `rows` rows of 128 bytes, row-major.
+struct DatabaseDescriptors {
+  uint32_t image_id = 0;
+  int rows = 0;
+  std::vector<uint8_t> data;
+};
+
+// Every image's descriptors, by image id. Throws BadInputError naming the file if it cannot be
+// read or a descriptor is not 128 bytes.
+std::vector<DatabaseDescriptors> ReadDescriptors(const std::filesystem::path& database);
+
+// The feature matches of one pair of images, before any verification: (feature of the first,
+// feature of the second).
+struct RawMatches {
+  uint32_t first_image_id = 0;
+  uint32_t second_image_id = 0;
+  std::vector<std::array<uint32_t, 2>> matches;
+};
+
+// Every pair's matches before verification, as colmap's matchers stored them (first image id
+// below the second). Throws BadInputError naming the file if it cannot be read.
+std::vector<RawMatches> ReadRawMatches(const std::filesystem::path& database);
+
+// Stores `pairs` in the database's matches table, replacing what it held for them, in one
+// transaction: colmap's matchers then verify these pairs without matching them again. Throws
+// BadInputError naming the file if it cannot be written.
+void WriteRawMatches(const std::filesystem::path& database, const std::vector<RawMatches>& pairs);
 
 }  // namespace parallax

@@ -17,6 +17,7 @@
 #include "pipeline/key_photos.h"
 #include "pipeline/raw_model_workspace.h"
 #include "pipeline/undistort_workspace.h"
+#include "sfm/feature_matching.h"
 #include "sfm/photo_conversion.h"
 
 namespace parallax {
@@ -74,7 +75,9 @@ struct Matching {
     const std::string tree = VocabularyTreeFile(sfm).string();
     const std::string neighbours = std::to_string(sfm.options.retrieval_images);
     switch (matcher) {
-      case MatcherChoice::kExhaustive: return Run("exhaustive_matcher", arguments, "matches");
+      case MatcherChoice::kExhaustive:
+        MatchEveryPair();
+        return Run("exhaustive_matcher", arguments, "matches, verification");
       case MatcherChoice::kSequential:
         arguments.insert(arguments.end(),
                          {"--SequentialMatching.overlap", std::to_string(sfm.options.sequential_overlap),
@@ -88,6 +91,35 @@ struct Matching {
         return Run("vocab_tree_matcher", arguments, "matches");
       case MatcherChoice::kAuto: throw InternalError("the automatic matcher is not decided");
     }
+  }
+
+  // Matches every pair of photos in the database by brute force (sfm/feature_matching.h), pairs
+  // on both cores, and stores the matches: colmap's exhaustive matcher then only verifies them.
+  void MatchEveryPair() const {
+    const std::vector<DatabaseDescriptors> images = ReadDescriptors(database);
+    std::vector<RawMatches> pairs;
+    std::vector<std::array<size_t, 2>> indices;
+    for (size_t i = 0; i < images.size(); ++i) {
+      for (size_t j = i + 1; j < images.size(); ++j) {
+        pairs.push_back({images[i].image_id, images[j].image_id, {}});
+        indices.push_back({i, j});
+      }
+    }
+    auto descriptors = [&](size_t i) {
+      return SiftDescriptors{images[i].data.data(), images[i].rows};
+    };
+    const int total = static_cast<int>(pairs.size());
+    sfm.progress.Update("matches", 0, total);
+    // Pairs in parallel, progress from this thread only (core/progress.h).
+    for (int start = 0; start < total; start += 16) {
+      const int end = std::min(total, start + 16);
+      tbb::parallel_for(start, end, [&](int p) {
+        const auto [i, j] = indices[static_cast<size_t>(p)];
+        pairs[static_cast<size_t>(p)].matches = MatchSiftFeatures(descriptors(i), descriptors(j));
+      });
+      sfm.progress.Update("matches", end, total);
+    }
+    WriteRawMatches(database, pairs);
   }
 
   void Run(const std::string& command, const std::vector<std::string>& arguments,
@@ -279,8 +311,9 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
       .Add(sfm.matcher != MatcherChoice::kExhaustive)
       .Add(static_cast<uint64_t>(sfm.options.sequential_overlap))
       .Add(quality.guided_matching);
-  // Exhaustive matching keeps the key it had before the other matchers came.
-  if (sfm.matcher != MatcherChoice::kExhaustive) {
+  if (sfm.matcher == MatcherChoice::kExhaustive) {
+    hasher.Add("sift-brute-force");  // parallax's matching, colmap's verification.
+  } else {
     hasher.Add(vocabulary_tree_key)
         .Add(static_cast<uint64_t>(sfm.matcher))
         .Add(static_cast<uint64_t>(sfm.options.retrieval_images))

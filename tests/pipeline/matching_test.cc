@@ -1,12 +1,16 @@
-// The matcher past the exhaustive limit, through the real colmap on example_images/courtyard
-// (24 photos 15 degrees apart on a ring; every other one is too sparse for SfM at fast
-// quality): sequential for photos in capture order, retrieval when their names are shuffled,
-// both from a vocabulary tree built from the photos (built once, in the ordered run, and given
-// to the shuffled one as --vocab-tree would).
+// Matching through the real colmap on example_images/courtyard (24 photos 15 degrees apart on a
+// ring; every other one is too sparse for SfM at fast quality): up to the exhaustive limit,
+// parallax's brute force against colmap's own matcher; past it, sequential for photos in
+// capture order, retrieval when their names are shuffled, both from a vocabulary tree built
+// from the photos (built once, in the ordered run, and given to the shuffled one as
+// --vocab-tree would).
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -14,12 +18,14 @@
 #include <nlohmann/json.hpp>
 
 #include "colmap/database.h"
+#include "colmap/runner.h"
 #include "core/atomic_file.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
 #include "eval/evaluate.h"
 #include "pipeline/reconstruct.h"
+#include "sfm/feature_matching.h"
 #include "synth/scene.h"
 #include "synth/synth.h"
 #include "tests/temp_dir.h"
@@ -114,6 +120,85 @@ TEST(Matching, AnAutomaticChoiceUpToTheLimitIsExhaustiveAndNeedsNoTree) {
   const StageRecord& tree = StageNamed(plan, "vocabulary tree");
   EXPECT_TRUE(tree.skipped);
   EXPECT_NE(tree.reason.find("exhaustive matching"), std::string::npos) << tree.reason;
+}
+
+// Each pair's matches and its verified inliers, by image ids.
+struct PairCounts {
+  std::map<std::pair<uint32_t, uint32_t>, std::set<std::array<uint32_t, 2>>> matches;
+  std::map<std::pair<std::string, std::string>, int> inliers;
+};
+
+PairCounts ReadPairs(const fs::path& database) {
+  PairCounts counts;
+  for (const RawMatches& pair : ReadRawMatches(database)) {
+    counts.matches[{pair.first_image_id, pair.second_image_id}].insert(pair.matches.begin(), pair.matches.end());
+  }
+  for (const VerifiedPair& pair : ReadVerifiedPairs(database)) counts.inliers[{pair.first, pair.second}] = pair.inliers;
+  return counts;
+}
+
+// The brute-force matcher against colmap's own on the same features of six neighbouring
+// courtyard photos at fast quality, each then verified by colmap. colmap's k-d trees find
+// approximate neighbours by distance, the brute force the exact ones by dot product, and an
+// approximate second neighbour passes the ratio test more easily: each keeps a few matches the
+// other does not (~3%), and as many verify.
+TEST(Matching, BruteForceKeepsWhatColmapsMatcherKeeps) {
+  const TempDir folder;
+  const fs::path photos = folder.Path() / "photos";
+  fs::create_directories(photos);
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = "000" + std::to_string(i) + ".png";
+    fs::copy_file(kCourtyard / "images" / name, photos / name);
+  }
+  const Colmap colmap;
+  SilentProgress progress;
+  const fs::path theirs = folder.Path() / "colmap.db", ours = folder.Path() / "parallax.db";
+  const fs::path log = folder.Path() / "colmap.log";
+  colmap.Run("feature_extractor",
+             {"--database_path", theirs.string(), "--image_path", photos.string(), "--ImageReader.single_camera", "1",
+              "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "1024",
+              "--SiftExtraction.max_num_features", "2048"},
+             log, "features", 6, progress);
+  fs::copy_file(theirs, ours);
+  const std::vector<DatabaseDescriptors> images = ReadDescriptors(ours);
+  ASSERT_EQ(images.size(), 6u);
+  std::vector<RawMatches> pairs;
+  for (size_t i = 0; i < images.size(); ++i) {
+    for (size_t j = i + 1; j < images.size(); ++j) {
+      pairs.push_back({images[i].image_id, images[j].image_id,
+                       MatchSiftFeatures({images[i].data.data(), images[i].rows},
+                                         {images[j].data.data(), images[j].rows})});
+    }
+  }
+  WriteRawMatches(ours, pairs);
+  for (const fs::path& database : {theirs, ours}) {
+    colmap.Run("exhaustive_matcher", {"--database_path", database.string(), "--SiftMatching.use_gpu", "0"}, log,
+               "matches", 6, progress);
+  }
+
+  const PairCounts colmap_pairs = ReadPairs(theirs), parallax_pairs = ReadPairs(ours);
+  ASSERT_EQ(colmap_pairs.matches.size(), 15u);
+  ASSERT_EQ(parallax_pairs.matches.size(), 15u);
+  size_t colmap_total = 0, parallax_total = 0, common = 0;
+  for (const auto& [pair, matches] : colmap_pairs.matches) {
+    const std::set<std::array<uint32_t, 2>>& mine = parallax_pairs.matches.at(pair);
+    colmap_total += matches.size();
+    parallax_total += mine.size();
+    for (const auto& match : matches) common += mine.count(match);
+  }
+  int colmap_inliers = 0, parallax_inliers = 0;
+  for (const auto& [pair, inliers] : colmap_pairs.inliers) colmap_inliers += inliers;
+  for (const auto& [pair, inliers] : parallax_pairs.inliers) parallax_inliers += inliers;
+  std::printf("[ measure ] matches: colmap %zu, brute force %zu, common %zu; verified pairs %zu / %zu, "
+              "inliers %d / %d\n",
+              colmap_total, parallax_total, common, colmap_pairs.inliers.size(), parallax_pairs.inliers.size(),
+              colmap_inliers, parallax_inliers);
+  EXPECT_GT(colmap_total, 1000u);
+  EXPECT_GE(common, colmap_total * 93 / 100);
+  EXPECT_GE(common, parallax_total * 93 / 100);
+  // 14 or 15 pairs verify, either way: the pair 75 degrees apart is on the edge (~15 inliers).
+  EXPECT_GE(parallax_pairs.inliers.size() + 1, colmap_pairs.inliers.size());
+  EXPECT_GE(parallax_inliers, colmap_inliers * 97 / 100);
 }
 
 // Past a hierarchical limit of 10 images the 24 photos are mapped in clusters of at most 10,
