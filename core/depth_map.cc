@@ -132,14 +132,6 @@ size_t PixelAtCentre(int grid_width, int grid_height, int width, int height, int
   return static_cast<size_t>(gy) * static_cast<size_t>(grid_width) + static_cast<size_t>(gx);
 }
 
-DepthMap UpsampleNearest(const DepthMap& depth, int width, int height) {
-  if (depth.Width() == width && depth.Height() == height) return depth;
-  const std::vector<size_t> nearest = PixelsAtCentres(depth.Width(), depth.Height(), width, height);
-  DepthMap full(width, height);
-  for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
-  return full;
-}
-
 DepthMap ReadDepthExrAt(const fs::path& path, int width, int height) {
   DepthMap depth = ReadDepthExr(path);
   // A working size of the photo: no larger, and each side scaled alike (to a pixel's rounding).
@@ -149,7 +141,11 @@ DepthMap ReadDepthExrAt(const fs::path& path, int width, int height) {
                         std::to_string(depth.Height()) + ": neither its photo's size (" + std::to_string(width) +
                         "x" + std::to_string(height) + ") nor a smaller one of its shape");
   }
-  return UpsampleNearest(depth, width, height);
+  if (depth.Width() == width && depth.Height() == height) return depth;
+  const std::vector<size_t> nearest = PixelsAtCentres(depth.Width(), depth.Height(), width, height);
+  DepthMap full(width, height);
+  for (size_t i = 0; i < nearest.size(); ++i) full.Values()[i] = depth.Values()[nearest[i]];
+  return full;
 }
 
 void WriteDepthExr(const fs::path& path, const DepthMap& depth) {

@@ -52,10 +52,6 @@ std::vector<size_t> PixelsAtCentres(int grid_width, int grid_height, int width, 
 // The same for the one pixel (x, y).
 size_t PixelAtCentre(int grid_width, int grid_height, int width, int height, int x, int y);
 
-// `depth` at width x height: itself when it has that size, else each pixel holds the value of
-// the map's pixel its centre falls in (PixelsAtCentres).
-DepthMap UpsampleNearest(const DepthMap& depth, int width, int height);
-
 // A COLMAP dense array: `channels` planes of width x height floats, channel-major.
 struct DenseArray {
   int width = 0;
@@ -69,7 +65,8 @@ struct DenseArray {
 // values, NaN or Inf.
 DepthMap ReadDepthExr(const std::filesystem::path& path);
 // A depth EXR read at a photo's width x height: the depth stage writes its maps at its working
-// size, which may be smaller; they are upsampled nearest (UpsampleNearest). Throws
+// size, which may be smaller; each pixel then holds the value of the map's pixel its centre
+// falls in (PixelsAtCentres: nearest, never blending depths across an edge). Throws
 // BadInputError naming the file when the map is larger than the photo or of another shape.
 DepthMap ReadDepthExrAt(const std::filesystem::path& path, int width, int height);
 // Writes one float32 channel named "Z", ZIP-compressed (lossless), atomically. Throws
