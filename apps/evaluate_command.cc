@@ -70,17 +70,20 @@ void PrintCloudAndMesh(const WorkspaceEvaluation& evaluation) {
   for (const std::string& line : evaluation.not_scored) std::printf("not scored: %s\n", line.c_str());
 }
 
-// Each view's loss budget: its pixels by kind (share, PSNR, dB the frame loses to them).
+// Each view's loss budget: its pixels by kind (share, PSNR, dB the frame loses to them), and
+// how far its covered pixels sit from the photo's (flow median and 90th percentile).
 void PrintBudgets(const NovelEvaluation& result) {
-  std::printf("%-16s %21s %21s %21s %9s\n", "loss budget", "covered", "background (sky)", "filled",
-              "exposure");
-  std::printf("%-16s %21s %21s %21s %9s\n", "", "share  PSNR  lost", "share  PSNR  lost", "share  PSNR  lost", "dB");
+  std::printf("%-16s %21s %21s %21s %9s %13s\n", "loss budget", "covered", "background (sky)", "filled",
+              "exposure", "misaligned px");
+  std::printf("%-16s %21s %21s %21s %9s %13s\n", "", "share  PSNR  lost", "share  PSNR  lost",
+              "share  PSNR  lost", "dB", "median    p90");
   const auto row = [](const std::string& name, const LossBudget& budget) {
     std::printf("%-16s", name.c_str());
     for (const PixelShareLoss* part : {&budget.covered, &budget.background, &budget.filled}) {
       std::printf(" %5.1f%% %5.2f %6.2f", 100 * part->share, part->psnr, part->db_lost);
     }
-    std::printf(" %+9.2f\n", budget.exposure_db);
+    std::printf(" %+9.2f %6.2f %6.2f\n", budget.exposure_db, budget.misalignment.median_px,
+                budget.misalignment.p90_px);
   };
   for (const NovelViewScore& view : result.per_view) row(view.name, view.budget);
   row("mean", result.budget_mean);

@@ -3,7 +3,7 @@
 # and what they pull (VTK, Open MPI, Tesseract: 43 packages, 330 MB unpacked). The modules'
 # own -dev packages (libopencv-core-dev, ...) hold their headers and libraries but no CMake
 # package, so they are found here.
-set(parallax_opencv_modules core imgproc imgcodecs calib3d photo)
+set(parallax_opencv_modules core imgproc imgcodecs calib3d photo video)
 
 find_path(PARALLAX_OPENCV_INCLUDE_DIR opencv2/core/version.hpp PATH_SUFFIXES opencv4
           DOC "OpenCV 4 headers (Debian package libopencv-core-dev)" REQUIRED)

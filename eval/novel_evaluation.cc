@@ -25,10 +25,14 @@ Eigen::Vector3f ClassColor(PixelClass pixel_class) {
   return {1, 1, 1};
 }
 
-// render | truth | |error| x 4 | classes, side by side (sRGB).
-Image SideBySide(const Image& render, const Image& truth, const ClassMap& classes) {
+// The flow length that shows white in the comparison's misalignment panel.
+constexpr float kFlowWhitePx = 4;
+
+// render | truth | |error| x 4 | classes | flow length where `aligned`, side by side (sRGB).
+Image SideBySide(const Image& render, const Image& truth, const ClassMap& classes, const Image& flow_length,
+                 const std::vector<uint8_t>& aligned) {
   const int w = render.Width(), h = render.Height();
-  Image out(4 * w, h, 3);
+  Image out(5 * w, h, 3);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const Eigen::Vector3f pixel_class = ClassColor(classes.At(x, y));
@@ -37,6 +41,9 @@ Image SideBySide(const Image& render, const Image& truth, const ClassMap& classe
         out.At(w + x, y, c) = truth.At(x, y, c);
         out.At(2 * w + x, y, c) = std::min(1.0f, 4 * std::abs(render.At(x, y, c) - truth.At(x, y, c)));
         out.At(3 * w + x, y, c) = pixel_class[c];
+        out.At(4 * w + x, y, c) = aligned[static_cast<size_t>(y) * w + x]
+                                      ? std::min(1.0f, flow_length.At(x, y, 0) / kFlowWhitePx)
+                                      : 0.0f;
       }
     }
   }
@@ -84,8 +91,16 @@ PixelShareLoss ShareLoss(const Image& render, const Image& truth, const std::vec
   return loss;
 }
 
+// The pixels set in both masks.
+std::vector<uint8_t> Both(std::vector<uint8_t> mask, const std::vector<uint8_t>& other) {
+  for (size_t p = 0; p < mask.size(); ++p) mask[p] = mask[p] && other[p];
+  return mask;
+}
+
+// `aligned`: the covered pixels whose misalignment is measured.
 LossBudget BudgetOf(const Image& render, const Image& truth, const ClassMap& classes, const HoleMetrics& metrics,
-                    double psnr, double psnr_exposure_matched) {
+                    double psnr, double psnr_exposure_matched, const Image& flow_length,
+                    const std::vector<uint8_t>& aligned) {
   LossBudget budget;
   budget.covered = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kCovered}), psnr);
   budget.background = ShareLoss(render, truth, MaskOf(classes, {PixelClass::kBackground}), psnr);
@@ -93,10 +108,12 @@ LossBudget BudgetOf(const Image& render, const Image& truth, const ClassMap& cla
       render, truth, MaskOf(classes, {PixelClass::kOutOfView, PixelClass::kCrack, PixelClass::kDisocclusion}), psnr);
   budget.out_of_view_share = metrics.out_of_view_ratio;
   budget.exposure_db = psnr_exposure_matched - psnr;
+  budget.misalignment = MisalignmentOf(flow_length, aligned);
   return budget;
 }
 
-// The mean of the views' budgets; each class's PSNR over the views that have its pixels.
+// The mean of the views' budgets; each class's PSNR, and the misalignment, over the views that
+// have its pixels.
 LossBudget MeanBudget(const std::vector<NovelViewScore>& views) {
   LossBudget mean;
   std::array<int, 3> with_pixels{0, 0, 0};
@@ -114,6 +131,10 @@ LossBudget MeanBudget(const std::vector<NovelViewScore>& views) {
     }
     mean.out_of_view_share += view.budget.out_of_view_share;
     mean.exposure_db += view.budget.exposure_db;
+    if (view.budget.covered.share > 0) {
+      mean.misalignment.median_px += view.budget.misalignment.median_px;
+      mean.misalignment.p90_px += view.budget.misalignment.p90_px;
+    }
   }
   if (views.empty()) return mean;
   const auto n = static_cast<double>(views.size());
@@ -125,6 +146,10 @@ LossBudget MeanBudget(const std::vector<NovelViewScore>& views) {
   }
   mean.out_of_view_share /= n;
   mean.exposure_db /= n;
+  if (with_pixels[0] > 0) {
+    mean.misalignment.median_px /= with_pixels[0];
+    mean.misalignment.p90_px /= with_pixels[0];
+  }
   return mean;
 }
 
@@ -150,12 +175,16 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
     const std::vector<uint8_t> sampled =
         MaskOf(view.result.classes, {PixelClass::kCovered, PixelClass::kBackground});
     const HoleMetrics& metrics = view.result.metrics;
+    // The flow is measured at the photo's exposure: a gain would bias its brightness matching.
+    const Image exposure_matched = ExposureMatched(view.result.color, truth_image, sampled);
+    const Image flow_length = FlowLength(exposure_matched, truth_image);
+    const std::vector<uint8_t> aligned =
+        Both(MaskOf(view.result.classes, {PixelClass::kCovered}), TexturedPixels(truth_image));
     NovelViewScore score{targets[i].name, Psnr(render, truth_image), Ssim(render, truth_image),
-                               Psnr(render, truth_image, sampled),
-                               Psnr(ExposureMatched(view.result.color, truth_image, sampled), truth_image),
+                               Psnr(render, truth_image, sampled), Psnr(exposure_matched, truth_image),
                                metrics.hole_ratio, view.sources, {}};
-    score.budget =
-        BudgetOf(render, truth_image, view.result.classes, metrics, score.psnr, score.psnr_exposure_matched);
+    score.budget = BudgetOf(render, truth_image, view.result.classes, metrics, score.psnr,
+                            score.psnr_exposure_matched, flow_length, aligned);
     evaluation.per_view.push_back(score);
     evaluation.psnr_mean += score.psnr;
     evaluation.ssim_mean += score.ssim;
@@ -171,7 +200,7 @@ NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<Nam
     if (!comparison_dir.empty()) {
       fs::create_directories(comparison_dir);
       WriteImage(comparison_dir / (targets[i].name + ".png"),
-                 SideBySide(render, truth_image, view.result.classes), PixelFormat::kUint8);
+                 SideBySide(render, truth_image, view.result.classes, flow_length, aligned), PixelFormat::kUint8);
     }
   }
   if (evaluation.views > 0) {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/scene_folder.h"
+#include "eval/misalignment.h"
 #include "reproject/novel_views.h"
 
 namespace parallax {
@@ -20,13 +21,16 @@ struct PixelShareLoss {
 
 // Where a view's error comes from (docs/novel-views.md): the pixels warped surfaces covered,
 // those only background (sky) covered, and those the fill made (holes and out of view); and
-// what matching the render's exposure to the photo gains.
+// what matching the render's exposure to the photo gains; and how far the covered pixels sit
+// from where the photo shows them (the flow from the exposure-matched render to the photo, on
+// the covered pixels where the photo has texture).
 struct LossBudget {
   PixelShareLoss covered;
   PixelShareLoss background;
   PixelShareLoss filled;
   double out_of_view_share = 0;  // Of the filled pixels, those no source saw at all.
   double exposure_db = 0;        // Exposure-matched PSNR minus PSNR.
+  Misalignment misalignment;     // On the covered pixels the photo has texture at.
 };
 
 // One novel view's scores (as the means below).
@@ -66,7 +70,8 @@ struct NovelEvaluation {
 // Renders every camera of `targets` (in the sources' frame; names are the stems of the
 // ground-truth images in `truth.images`) and compares. With a non-empty `comparison_dir`,
 // writes <name>.png there: render | ground truth | error x4 | pixel classes (covered black,
-// background blue, out of view grey, crack yellow, disocclusion red).
+// background blue, out of view grey, crack yellow, disocclusion red) | misalignment (the flow's
+// length where it is measured, white at 4 px and more).
 NovelEvaluation EvaluateNovelViews(SourceLibrary& library, const std::vector<NamedCamera>& targets,
                                    const std::vector<std::string>& truth_image_names,
                                    const ViewSetPaths& truth,

@@ -208,7 +208,8 @@ nlohmann::json BudgetJson(const LossBudget& budget) {
           {"background", part(budget.background)},
           {"filled", part(budget.filled)},
           {"out_of_view_share", budget.out_of_view_share},
-          {"exposure_db", budget.exposure_db}};
+          {"exposure_db", budget.exposure_db},
+          {"misalignment_px", {{"median", budget.misalignment.median_px}, {"p90", budget.misalignment.p90_px}}}};
 }
 
 WorkspaceEvaluation EvaluateHeldOut(const Workspace& workspace, const EvaluateOptions& options) {

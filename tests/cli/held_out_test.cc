@@ -95,6 +95,13 @@ TEST(HeldOut, HeldOutPhotosAreRegisteredKeptOutOfTheDenseStagesAndScored) {
   const nlohmann::json scores = ReadJson(workspace.Root() / "evaluation.json")["novel"];
   EXPECT_EQ(scores["views"], 4);
   for (const nlohmann::json& view : scores["per_view"]) ExpectBudgetAddsUp(view);
+  // The held-out photos' SfM cameras put the scene within a pixel of where they show it.
+  const nlohmann::json& misaligned = scores["budget_mean"]["misalignment_px"];
+  std::printf("[ measure ] misalignment at the held-out cameras: median %.3f px, p90 %.3f px\n",
+              misaligned["median"].get<double>(), misaligned["p90"].get<double>());
+  EXPECT_GT(misaligned["median"].get<double>(), 0);
+  EXPECT_LT(misaligned["median"].get<double>(), 1);
+  EXPECT_LE(misaligned["median"].get<double>(), misaligned["p90"].get<double>());
 
   // The textured mesh at the same held-out cameras: its renders and coverage masks written, its
   // whole frames (missed pixels black) below the pixels it covers, and against its own masks
