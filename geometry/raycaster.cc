@@ -1,6 +1,7 @@
 #include "geometry/raycaster.h"
 
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -44,7 +45,6 @@ RTCRay MakeRay(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction, 
 
 std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
                                               const Rigid3d& cam_from_world) const {
-  if (camera.HasDistortion()) throw InternalError("CastPixels: camera has distortion");
   const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
   std::vector<RayHit> hits(static_cast<size_t>(width) * height);
   const Eigen::Matrix3d world_from_cam = cam_from_world.rotation.conjugate().toRotationMatrix();
@@ -53,12 +53,13 @@ std::vector<RayHit> MeshRaycaster::CastPixels(const Camera& camera,
     std::vector<RTCRayHit> rays(static_cast<size_t>(width));
     for (int y = rows.begin(); y < rows.end(); ++y) {
       for (int x = 0; x < width; ++x) {
-        // z = 1 in the camera frame: the hit distance is the z-depth.
-        const Eigen::Vector3d in_cam((x + 0.5 - camera.PrincipalX()) / camera.FocalX(),
-                                     (y + 0.5 - camera.PrincipalY()) / camera.FocalY(), 1.0);
+        // z = 1 in the camera frame: the hit distance is the z-depth. A pixel whose distortion
+        // cannot be inverted gets an inactive ray (tfar < tnear), which hits nothing.
+        const std::optional<Eigen::Vector3d> in_cam = camera.Unproject(Eigen::Vector2d(x + 0.5, y + 0.5));
         RTCRayHit& ray = rays[static_cast<size_t>(x)];
-        ray.ray = MakeRay(eye, (world_from_cam * in_cam).cast<float>(),
-                          std::numeric_limits<float>::infinity());
+        constexpr float kInfinity = std::numeric_limits<float>::infinity();
+        ray.ray = MakeRay(eye, (world_from_cam * in_cam.value_or(Eigen::Vector3d::UnitZ())).cast<float>(),
+                          in_cam ? kInfinity : -kInfinity);
         ray.hit.geomID = RTC_INVALID_GEOMETRY_ID;
         ray.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
       }

@@ -28,7 +28,8 @@ class MeshRaycaster {
   MeshRaycaster(const MeshRaycaster&) = delete;
   MeshRaycaster& operator=(const MeshRaycaster&) = delete;
 
-  // One ray through each pixel centre of a distortion-free camera, row-major. All threads.
+  // One ray through each pixel centre of `camera`, through its distortion (a pixel where it
+  // cannot be inverted hits nothing), row-major. All threads.
   std::vector<RayHit> CastPixels(const Camera& camera, const Rigid3d& cam_from_world) const;
 
   // For each point, whether the open segment from `eye` to it (shortened by `tolerance` of its
