@@ -182,6 +182,7 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   for (const auto& [name, staged_name] : staged) {
     if (const SparseImage* image = with_held_out.FindImageByName(staged_name)) {
       result.cam_from_world[name] = image->cam_from_world;
+      result.cameras[name] = with_held_out.CameraById(image->camera_id);
     }
   }
   result.note = std::to_string(result.cam_from_world.size()) + " of " +

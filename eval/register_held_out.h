@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/pose.h"
 #include "core/progress.h"
 
@@ -13,6 +14,7 @@ namespace parallax {
 
 struct HeldOutRegistration {
   std::map<std::string, Rigid3d> cam_from_world;  // By image name; the registered ones only.
+  std::map<std::string, Camera> cameras;          // The camera each pose was solved with.
   std::string note;  // What was done (or reused), or why nothing was registered.
 };
 
@@ -27,9 +29,10 @@ struct HeldOutRegistration {
 // and database size reuses the result. The photos are registered under prefixed names, so they may
 // share names with training photos. Returns an empty map and the reason when the workspace has no
 // database (e.g. made from known cameras) or COLMAP fails; throws BadInputError when report.json's
-// record of the features is damaged, and lets every other error through. The rendered targets keep
-// their own (ground-truth) intrinsics: the registration solves the pose with the workspace's
-// estimated camera.
+// record of the features is damaged, and lets every other error through. The registration solves
+// each pose with the workspace's estimated camera, so a render puts the scene where the photo
+// shows it with that camera and pose only: the ground-truth intrinsics with the same pose would
+// shift it by their difference (2.2, 2.6 px of principal point on castle-p19).
 HeldOutRegistration RegisterHeldOutPhotos(const std::filesystem::path& workspace,
                                           const std::filesystem::path& images_dir,
                                           const std::vector<std::string>& names,

@@ -128,7 +128,7 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
     for (size_t i = 0; i < names.size(); ++i) {
       const auto found = registration.cam_from_world.find(names[i]);
       if (found == registration.cam_from_world.end()) continue;
-      targets[i].camera.cam_from_world = found->second;
+      targets[i].camera = {registration.cameras.at(names[i]), found->second};
       ++evaluation.poses_registered;
     }
     evaluation.registration_tried = true;

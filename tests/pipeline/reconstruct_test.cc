@@ -102,6 +102,10 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   // Measured: 3 of the 4 register (one seen from 1 m up, across the scene, shares too few
   // features with the arc); evaluate takes that one's pose from the alignment.
   EXPECT_GE(held_out.cam_from_world.size(), 3u) << held_out.note;
+  // Each pose comes with the camera it was solved with: the workspace's, unmoved.
+  const Camera shared = ReadSparseModel(Workspace(workspace.Path()).RawModel()).Cameras().front();
+  EXPECT_EQ(held_out.cameras.size(), held_out.cam_from_world.size());
+  for (const auto& [name, camera] : held_out.cameras) EXPECT_EQ(camera.params, shared.params) << name;
   for (const SparseImage& image : novel.Images()) {
     if (!held_out.cam_from_world.contains(image.name)) continue;
     const Rigid3d pose =
