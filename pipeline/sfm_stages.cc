@@ -1,6 +1,7 @@
 #include "pipeline/sfm_stages.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <functional>
 #include <optional>
@@ -150,6 +151,46 @@ PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, parts, sfm.options);
   if (check.keep) WriteSparseModel(model, sfm.workspace.RawModel(), SparseFormat::kBinary);
   return check;
+}
+
+// After mapping, observations farther than this from their point's projection (in pixels of
+// the photos as SIFT saw them) are dropped and the model is adjusted again. colmap's mapper keeps
+// up to 4 px, and under squared errors that tail of mismatched or coarse keypoints sets the
+// poses (docs/cameras.md, "The tail of the observations").
+constexpr double kMaxReprojectionErrorPx = 1;
+
+size_t Observations(const SparseModel& model) {
+  size_t observations = 0;
+  for (const Point3D& point : model.Points3D()) observations += point.track.size();
+  return observations;
+}
+
+// The raw model without its observations over kMaxReprojectionErrorPx, adjusted again
+// (intrinsics held where they are fixed); returns report.json's note.
+std::string FilterAndAdjustRawModel(const SfmContext& sfm) {
+  const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
+  // Keypoints of photos SIFT saw downscaled are that much coarser in the photos' pixels.
+  const double extracted_px = SettingsFor(sfm.options.quality).max_image_size;
+  double scale = 1;
+  for (const Camera& camera : raw.Cameras()) {
+    scale = std::max(scale, static_cast<double>(std::max(camera.width, camera.height)) / extracted_px);
+  }
+  const double threshold_px = kMaxReprojectionErrorPx * scale;
+  const SparseModel filtered = RunOnRawModel(sfm.colmap, sfm.workspace, "point_filtering",
+                                             {"--max_reproj_error", std::to_string(threshold_px)}, "filter", 0,
+                                             sfm.progress);
+  WriteSparseModel(filtered, sfm.workspace.RawModel(), SparseFormat::kBinary);
+  std::vector<std::string> options;
+  if (sfm.camera.fixed_intrinsics) {
+    options = {"--BundleAdjustment.refine_focal_length", "0", "--BundleAdjustment.refine_extra_params", "0"};
+  }
+  WriteSparseModel(AdjustRawModel(sfm.colmap, sfm.workspace, options, "filter_adjust", sfm.progress),
+                   sfm.workspace.RawModel(), SparseFormat::kBinary);
+  char note[200];
+  std::snprintf(note, sizeof note,
+                "observations over %.2f px from their points dropped (%zu of %zu) and the model adjusted again",
+                threshold_px, Observations(raw) - Observations(filtered), Observations(raw));
+  return note;
 }
 
 // `model`'s cameras and images, without points and keypoints.
@@ -376,6 +417,7 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
     hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images)).Add("adjusted-2");
   }
   if (key_photos) hasher.Add("key photos").Add(ImageListText(plan.key_photos));
+  if (!sfm.known) hasher.Add("filtered and adjusted-1");
   stage.key = hasher.Hex();
   stage.outputs = {paths.RawModel()};
   stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, key_photos,
@@ -420,6 +462,10 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
       WriteSparseModel(AdjustRawModel(sfm.colmap, paths, {}, "adjust", sfm.progress), paths.RawModel(),
                        SparseFormat::kBinary);
     }
+    // After the principal point's check, which needs the whole tail to see its scatter (on
+    // entry-p10 the filtered model moved the point from 0.8% to 0.6% off-centre, and the
+    // cameras with it).
+    if (!sfm.known) notes.push_back(FilterAndAdjustRawModel(sfm));
     if (key_photos) {
       WriteSparseModel(RegisterOtherPhotos(sfm.colmap, paths,
                                            sfm.camera.fixed_intrinsics ? FixedIntrinsicsArguments()

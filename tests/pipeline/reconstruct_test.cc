@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -65,6 +66,24 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   EXPECT_LT(evaluation.rotation_error_mean_deg, 0.5);
   EXPECT_LT(evaluation.center_error_rel_mean, 0.02);
   EXPECT_EQ(evaluation.alignment.inliers, 12);
+  // The mapper's model without its observations over 1 px from their points, adjusted again.
+  const SparseModel raw = ReadSparseModel(Workspace(workspace.Path()).RawModel());
+  double worst_px = 0;
+  for (const Point3D& point : raw.Points3D()) {
+    for (const TrackElement& element : point.track) {
+      const SparseImage& image = raw.ImageById(element.image_id);
+      const std::optional<Eigen::Vector2d> pixel =
+          raw.CameraById(image.camera_id).Project(image.cam_from_world * point.xyz);
+      ASSERT_TRUE(pixel.has_value());
+      worst_px = std::max(worst_px, (*pixel - image.points2d[element.point2d_idx].xy).norm());
+    }
+  }
+  // The adjustment after the filter moves a few a little past it.
+  EXPECT_LT(worst_px, 1.5);
+  const std::vector<std::string> notes = summary.notes;
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& note) {
+    return note.find("observations over 1.00 px from their points dropped") != std::string::npos;
+  })) << ::testing::PrintToString(notes);
 
   // Multi-view stereo: the dense files of docs/design.md, and depth measured in the true cameras.
   for (const char* file : {"stereo/depth_maps/0005.png.geometric.bin",
