@@ -181,11 +181,10 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   const SparseModel with_held_out = ReadSparseModel(registered);
   for (const auto& [name, staged_name] : staged) {
     if (const SparseImage* image = with_held_out.FindImageByName(staged_name)) {
-      result.cam_from_world[name] = image->cam_from_world;
-      result.cameras[name] = with_held_out.CameraById(image->camera_id);
+      result.registered[name] = {with_held_out.CameraById(image->camera_id), image->cam_from_world};
     }
   }
-  result.note = std::to_string(result.cam_from_world.size()) + " of " +
+  result.note = std::to_string(result.registered.size()) + " of " +
                 std::to_string(names.size()) +
                 " registered into the SfM model by colmap image_registrator (SIFT at up to " +
                 std::to_string(features.max_image_size) + " px, " + std::to_string(features.max_num_features) +

@@ -6,15 +6,14 @@
 #include <string>
 #include <vector>
 
-#include "core/camera.h"
-#include "core/pose.h"
 #include "core/progress.h"
+#include "reproject/view.h"
 
 namespace parallax {
 
 struct HeldOutRegistration {
-  std::map<std::string, Rigid3d> cam_from_world;  // By image name; the registered ones only.
-  std::map<std::string, Camera> cameras;          // The camera each pose was solved with.
+  // By image name, the registered ones only: each pose with the camera it was solved with.
+  std::map<std::string, PosedCamera> registered;
   std::string note;  // What was done (or reused), or why nothing was registered.
 };
 

@@ -126,9 +126,9 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
     const HeldOutRegistration registration = RegisterHeldOutPhotos(
         workspace.Root(), scene.Novel().images, names, EvaluationLayout(workspace.Root()).NovelRegistration(), progress);
     for (size_t i = 0; i < names.size(); ++i) {
-      const auto found = registration.cam_from_world.find(names[i]);
-      if (found == registration.cam_from_world.end()) continue;
-      targets[i].camera = {registration.cameras.at(names[i]), found->second};
+      const auto found = registration.registered.find(names[i]);
+      if (found == registration.registered.end()) continue;
+      targets[i].camera = found->second;
       ++evaluation.poses_registered;
     }
     evaluation.registration_tried = true;

@@ -120,15 +120,14 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
       RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, work, progress);
   // Measured: 3 of the 4 register (one seen from 1 m up, across the scene, shares too few
   // features with the arc); evaluate takes that one's pose from the alignment.
-  EXPECT_GE(held_out.cam_from_world.size(), 3u) << held_out.note;
+  EXPECT_GE(held_out.registered.size(), 3u) << held_out.note;
   // Each pose comes with the camera it was solved with: the workspace's, unmoved.
   const Camera shared = ReadSparseModel(Workspace(workspace.Path()).RawModel()).Cameras().front();
-  EXPECT_EQ(held_out.cameras.size(), held_out.cam_from_world.size());
-  for (const auto& [name, camera] : held_out.cameras) EXPECT_EQ(camera.params, shared.params) << name;
+  for (const auto& [name, posed] : held_out.registered) EXPECT_EQ(posed.camera.params, shared.params) << name;
   for (const SparseImage& image : novel.Images()) {
-    if (!held_out.cam_from_world.contains(image.name)) continue;
+    if (!held_out.registered.contains(image.name)) continue;
     const Rigid3d pose =
-        evaluation.alignment.target_from_source.TransformPose(held_out.cam_from_world.at(image.name));
+        evaluation.alignment.target_from_source.TransformPose(held_out.registered.at(image.name).cam_from_world);
     const double angle_deg =
         pose.rotation.angularDistance(image.cam_from_world.rotation) * 180 / std::numbers::pi;
     // As accurate as the training cameras, within a factor of 2.
@@ -152,8 +151,8 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
       workspace.Path(), scene.Training().images, {"0003.png"}, workspace.Path() / "clash", progress);
   // A held-out photo may share a training photo's name (here it is that very photo): it is
   // registered all the same, onto the training camera.
-  ASSERT_TRUE(clash.cam_from_world.contains("0003.png")) << clash.note;
-  const Rigid3d& twin = clash.cam_from_world.at("0003.png");
+  ASSERT_TRUE(clash.registered.contains("0003.png")) << clash.note;
+  const Rigid3d& twin = clash.registered.at("0003.png").cam_from_world;
   const Rigid3d& original = model.FindImageByName("0003.png")->cam_from_world;
   EXPECT_LT(RotationAngleDeg(twin.rotation, original.rotation), 0.05);
   EXPECT_LT((CameraCenter(twin) - CameraCenter(original)).norm(), 0.002 * evaluation.extent);
@@ -164,8 +163,8 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
                   .write((tiff_dir.Path() / "0003.tif").string(), OIIO::TypeDesc::UINT16));
   const HeldOutRegistration tiff = RegisterHeldOutPhotos(workspace.Path(), tiff_dir.Path(), {"0003.tif"},
                                                          workspace.Path() / "tiff", progress);
-  ASSERT_TRUE(tiff.cam_from_world.contains("0003.tif")) << tiff.note;
-  EXPECT_LT(RotationAngleDeg(tiff.cam_from_world.at("0003.tif").rotation, original.rotation), 0.05);
+  ASSERT_TRUE(tiff.registered.contains("0003.tif")) << tiff.note;
+  EXPECT_LT(RotationAngleDeg(tiff.registered.at("0003.tif").cam_from_world.rotation, original.rotation), 0.05);
 
   // Real photos come with cameras and held-out photos but no depth: everything else is scored,
   // and what is not is said.
@@ -388,7 +387,7 @@ TEST(Reconstruct, HeldOutPhotosAreExtractedAsTheWorkspacesPhotosWere) {
 
   const HeldOutRegistration fast =
       RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "fast", progress);
-  EXPECT_GE(fast.cam_from_world.size(), 3u) << fast.note;  // 3 of 4, as with balanced's.
+  EXPECT_GE(fast.registered.size(), 3u) << fast.note;  // 3 of 4, as with balanced's.
   const std::string fast_extraction = HeldOutExtraction(workspace.Path() / "fast");
   EXPECT_NE(fast_extraction.find("--SiftExtraction.max_image_size 1024 --SiftExtraction.max_num_features 2048"),
             std::string::npos) << fast_extraction;
