@@ -267,18 +267,6 @@ SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& 
   return selected;
 }
 
-SparseModel SelectPoints(const SparseModel& model, size_t first, size_t step) {
-  SparseModel selected;
-  for (const Camera& camera : model.Cameras()) selected.AddCamera(camera);
-  std::unordered_set<uint64_t> points;
-  for (size_t i = first; i < model.Points3D().size(); i += step) {
-    selected.AddPoint3D(model.Points3D()[i]);
-    points.insert(model.Points3D()[i].id);
-  }
-  for (const SparseImage& image : model.Images()) selected.AddImage(ObservingOnly(image, points));
-  return selected;
-}
-
 void WriteSparseModel(const SparseModel& model, const fs::path& dir, SparseFormat format) {
   CheckWritable(model, format);
   if (format == SparseFormat::kBinary) {

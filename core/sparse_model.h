@@ -104,10 +104,6 @@ SparseModel ReadSparseModelWithoutKeypoints(const std::filesystem::path& dir);
 // other points' observations are cleared, so that colmap reads the model as whole.
 SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& names, bool keep);
 
-// Every camera and image of `model` and its points first, first + step, first + 2 step, ...;
-// the images' observations of the other points are cleared (their keypoints stay).
-SparseModel SelectPoints(const SparseModel& model, size_t first, size_t step);
-
 // Writes cameras, images and points3D in `format` into `dir` (created if missing). Each file is
 // written to a temporary name and renamed. Throws BadInputError if `dir` is not writable,
 // InternalError for a model the readers would refuse (a non-finite pose, say).

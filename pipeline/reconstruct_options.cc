@@ -34,6 +34,11 @@ void ReconstructOptions::Check() const {
                 refine_principal_point_min_images, ">= 1");
   RequireOption(max_refined_principal_point_offset > 0, "ReconstructOptions.max_refined_principal_point_offset",
                 max_refined_principal_point_offset, "> 0");
+  RequireOption(min_principal_point_prediction_gain >= 0 && min_principal_point_prediction_gain < 1,
+                "ReconstructOptions.min_principal_point_prediction_gain", min_principal_point_prediction_gain,
+                "in [0, 1)");
+  RequireOption(min_principal_point_deviations > 0, "ReconstructOptions.min_principal_point_deviations",
+                min_principal_point_deviations, "> 0");
   RequireOption(mvs_sources >= 0, "ReconstructOptions.mvs_sources", mvs_sources, ">= 0");
   RequireOption(mvs_scale == 0 || (mvs_scale >= 0.25 && mvs_scale <= 1), "ReconstructOptions.mvs_scale",
                 mvs_scale, "0 (as quality says) or [0.25, 1]");

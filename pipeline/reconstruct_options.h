@@ -86,6 +86,12 @@ struct ReconstructOptions {
   // The refinement is kept only if the principal point stays within this fraction of the
   // image size from the centre; further off it was not observable and drifted.
   double max_refined_principal_point_offset = 0.05;
+  // ... and if it predicts photos left out of the adjustment better than the centre does: by
+  // at least this share of their reprojection error, or by less where it lies at least
+  // `min_principal_point_deviations` standard deviations (the jackknife's over the photos) off
+  // the centre (docs/cameras.md, "The principal point by prediction").
+  double min_principal_point_prediction_gain = 0.003;
+  double min_principal_point_deviations = 3;
   // Photos held out of everything after structure from motion, as novel-view benchmarks hold
   // them out: registered with the others, then kept out of the depth stage, fusion, the mesh,
   // the color gains and the render sources, and written to Workspace::HeldOut for `evaluate`

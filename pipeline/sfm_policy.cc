@@ -272,6 +272,15 @@ bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& 
          num_images >= options.refine_principal_point_min_images;
 }
 
+std::vector<std::vector<std::string>> PhotoFolds(const SparseModel& model, size_t folds) {
+  std::vector<std::string> names;
+  for (const SparseImage& image : model.Images()) names.push_back(image.name);
+  std::sort(names.begin(), names.end());
+  std::vector<std::vector<std::string>> result(std::min(folds, names.size()));
+  for (size_t i = 0; i < names.size(); ++i) result[i % result.size()].push_back(names[i]);
+  return result;
+}
+
 namespace {
 
 Eigen::Vector2d PrincipalPoint(const Camera& camera) { return {camera.PrincipalX(), camera.PrincipalY()}; }
@@ -280,55 +289,79 @@ Eigen::Vector2d ImageCentre(const Camera& camera) {
   return {0.5 * static_cast<double>(camera.width), 0.5 * static_cast<double>(camera.height)};
 }
 
-// The standard deviation of `camera`'s refined principal point (pixels, per axis), from its
-// scatter over `parts`: a part's estimate has parts.size() times the whole's variance.
-double PrincipalPointDeviation(const Camera& camera, const std::vector<SparseModel>& parts) {
+const Camera& CameraWithId(const std::vector<Camera>& cameras, uint32_t id) {
+  for (const Camera& camera : cameras) {
+    if (camera.id == id) return camera;
+  }
+  throw InternalError("no camera " + std::to_string(id) + " in a fold's adjustment");
+}
+
+// The standard deviation of camera `id`'s refined principal point (pixels, per axis) by the
+// jackknife over the folds: each fold's estimate leaves out 1/K of the photos, and the
+// estimates' scatter times (K - 1) / K is the variance of the whole's.
+double JackknifeDeviation(uint32_t id, const std::vector<FoldPrediction>& folds) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const SparseModel& part : parts) mean += PrincipalPoint(part.CameraById(camera.id));
-  mean /= static_cast<double>(parts.size());
+  for (const FoldPrediction& fold : folds) mean += PrincipalPoint(CameraWithId(fold.freed_cameras, id));
+  const double k = static_cast<double>(folds.size());
+  mean /= k;
   double squares = 0;
-  for (const SparseModel& part : parts) squares += (PrincipalPoint(part.CameraById(camera.id)) - mean).squaredNorm();
-  const double k = static_cast<double>(parts.size());
-  return std::sqrt(squares / (2 * (k - 1)) / k);
+  for (const FoldPrediction& fold : folds) {
+    squares += (PrincipalPoint(CameraWithId(fold.freed_cameras, id)) - mean).squaredNorm();
+  }
+  return std::sqrt((k - 1) / k * squares / 2);
+}
+
+// The folds' left-out reprojection error together: the RMS over all their observations.
+double PooledRms(const std::vector<FoldPrediction>& folds, LeftOutError FoldPrediction::*side) {
+  double squares = 0;
+  size_t observations = 0;
+  for (const FoldPrediction& fold : folds) {
+    const LeftOutError& error = fold.*side;
+    squares += error.rms_px * error.rms_px * static_cast<double>(error.observations);
+    observations += error.observations;
+  }
+  return observations == 0 ? 0 : std::sqrt(squares / static_cast<double>(observations));
 }
 
 }  // namespace
 
-PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<SparseModel>& parts,
+PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<FoldPrediction>& folds,
                                                const ReconstructOptions& options) {
-  if (parts.size() < 2) throw InternalError("CheckRefinedPrincipalPoint needs two parts or more");
-  // The camera farthest off-centre, and the one whose offset is least certain, in pixels.
-  double worst_offset = 0, offset_px = 0, deviation_px = 0, least_significance = HUGE_VAL;
+  if (folds.size() < 2) throw InternalError("CheckRefinedPrincipalPoint needs two folds or more");
+  // The camera farthest off-centre, and the one whose offset is least certain.
+  double worst_offset = 0, deviation_px = 0, least_significance = HUGE_VAL;
   for (const Camera& camera : refined.Cameras()) {
     worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
-    const double offset = (PrincipalPoint(camera) - ImageCentre(camera)).norm();
-    const double deviation = PrincipalPointDeviation(camera, parts);
-    const double significance = offset / std::max(deviation, 1e-9);
+    const double deviation = JackknifeDeviation(camera.id, folds);
+    const double significance = (PrincipalPoint(camera) - ImageCentre(camera)).norm() / std::max(deviation, 1e-9);
     if (significance < least_significance) {
       least_significance = significance;
-      offset_px = offset;
       deviation_px = deviation;
     }
   }
-  char note[240];
+  char note[400];
   if (worst_offset > options.max_refined_principal_point_offset) {
     std::snprintf(note, sizeof(note),
                   "principal point kept at the image centre: the refined one drifted %.1f%% of the image size "
                   "off-centre (not observable in these photos)", 100 * worst_offset);
     return {false, note};
   }
-  if (least_significance < 3) {
-    std::snprintf(note, sizeof(note),
-                  "principal point kept at the image centre: the refined one, %.1f px off it, is within three "
-                  "standard deviations of its estimate (%.1f px, from %d parts of the points)",
-                  offset_px, deviation_px, static_cast<int>(parts.size()));
-    return {false, note};
-  }
+  const double centre_px = PooledRms(folds, &FoldPrediction::centre);
+  const double freed_px = PooledRms(folds, &FoldPrediction::freed);
+  const double gain = 1 - freed_px / std::max(centre_px, 1e-12);
+  const bool keep = gain > 0 && (gain >= options.min_principal_point_prediction_gain ||
+                                 least_significance >= options.min_principal_point_deviations);
+  const auto better = std::count_if(folds.begin(), folds.end(), [](const FoldPrediction& fold) {
+    return fold.freed.rms_px < fold.centre.rms_px;
+  });
   std::snprintf(note, sizeof(note),
-                "principal point refined in a final bundle adjustment: %.1f%% off-centre, %.1f standard "
-                "deviations of its estimate (%.1f px, from %d parts of the points)",
-                100 * worst_offset, least_significance, deviation_px, static_cast<int>(parts.size()));
-  return {true, note};
+                "principal point %s: the refined one is %.1f%% off-centre, %.1f standard deviations (%.1f px by the "
+                "jackknife over %d folds of the photos), and predicts the photos left out of it at %.3f px against "
+                "%.3f px from the centre (better in %d of the folds)",
+                keep ? "refined in a final bundle adjustment" : "kept at the image centre", 100 * worst_offset,
+                least_significance, deviation_px, static_cast<int>(folds.size()), freed_px, centre_px,
+                static_cast<int>(better));
+  return {keep, note};
 }
 
 }  // namespace parallax

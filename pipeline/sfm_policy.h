@@ -15,6 +15,7 @@
 #include "core/workspace.h"
 #include "pipeline/key_photos.h"
 #include "pipeline/reconstruct_options.h"
+#include "sfm/photo_prediction.h"
 #include "sfm/photo_set.h"
 #include "sfm/quality_settings.h"
 
@@ -124,23 +125,37 @@ std::set<std::string> HeldOutPhotos(const std::vector<std::string>& names, int e
 // camera whose intrinsics are estimated, from `options.refine_principal_point_min_images`.
 bool RefinesPrincipalPoint(const CameraSetup& camera, const ReconstructOptions& options, int num_images);
 
-// How many parts of the points the principal point is refined on apart (every K-th point,
-// SelectPoints), to measure how well the photos determine it.
-inline constexpr size_t kPrincipalPointParts = 4;
+// How many folds of the photos the principal point is checked on (every K-th registered photo
+// by name left out of each; one photo each where there are no more photos than folds).
+inline constexpr size_t kPrincipalPointFolds = 8;
+
+// The registered photos of `model` in `folds` folds: photo i by name in fold i mod
+// min(folds, photos).
+std::vector<std::vector<std::string>> PhotoFolds(const SparseModel& model, size_t folds);
+
+// One fold of the cross-validation by photos (sfm/photo_prediction.h): the reprojection error of
+// the photos it left out, predicted by the other photos adjusted with the principal point at the
+// centre and freed, and the cameras of the freed adjustment.
+struct FoldPrediction {
+  LeftOutError centre;
+  LeftOutError freed;
+  std::vector<Camera> freed_cameras;
+};
 
 // Whether a model whose principal points were refined is kept, and report.json's note saying
 // which and why. Kept where every camera's refined principal point is within
-// `options.max_refined_principal_point_offset` of the image centre and measurably off it:
-// farther from the centre than three standard deviations of its estimate. The refinements on
-// disjoint parts of the points (`parts`) give the deviation: with 1/K of the
-// points each, they scatter sqrt(K) times as widely. Otherwise the centre stays, as COLMAP keeps
-// it by default: a few photos of a facade cannot tell a shifted principal point from a turned
-// camera.
+// `options.max_refined_principal_point_offset` of the image centre and the refinement predicts
+// the photos left out of it (`folds`) better than the centre does: by the share
+// `options.min_principal_point_prediction_gain` of their reprojection error, or by less where
+// the point lies `options.min_principal_point_deviations` standard deviations off the centre
+// (the jackknife's over the folds). Otherwise the centre stays, as COLMAP keeps it by default:
+// along a narrow arc a shifted principal point trades against the rotations, fits the photos
+// it was adjusted on and predicts no others.
 struct PrincipalPointCheck {
   bool keep = false;
   std::string note;
 };
-PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<SparseModel>& parts,
+PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<FoldPrediction>& folds,
                                                const ReconstructOptions& options);
 
 }  // namespace parallax

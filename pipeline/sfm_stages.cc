@@ -136,28 +136,46 @@ std::string ImageListText(const std::vector<std::string>& names) {
   return list;
 }
 
-// A final bundle adjustment that also frees the principal point, written over the raw model
-// only where CheckRefinedPrincipalPoint keeps it, after the same adjustment of each of
-// kPrincipalPointParts parts of the points; returns the check (keep, report.json's note).
-PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
-  const std::vector<std::string> refine = {"--BundleAdjustment.refine_principal_point", "1"};
-  const SparseModel model = AdjustRawModel(sfm.colmap, sfm.workspace, refine, "refine", sfm.progress);
-  const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
-  std::vector<SparseModel> parts;
-  for (size_t part = 0; part < kPrincipalPointParts; ++part) {
-    parts.push_back(AdjustModel(sfm.colmap, sfm.workspace, SelectPoints(raw, part, kPrincipalPointParts), refine,
-                                "refine_part", sfm.progress));
+// How many of the photos' pixels one pixel of the photos as SIFT saw them spans (1 where
+// SIFT saw them whole): keypoints of downscaled photos are that much coarser.
+double ExtractionScale(const SparseModel& model, Quality quality) {
+  const double extracted_px = SettingsFor(quality).max_image_size;
+  double scale = 1;
+  for (const Camera& camera : model.Cameras()) {
+    scale = std::max(scale, static_cast<double>(std::max(camera.width, camera.height)) / extracted_px);
   }
-  const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, parts, sfm.options);
-  if (check.keep) WriteSparseModel(model, sfm.workspace.RawModel(), SparseFormat::kBinary);
-  return check;
+  return scale;
 }
 
 // After mapping, observations farther than this from their point's projection (in pixels of
 // the photos as SIFT saw them) are dropped and the model is adjusted again. colmap's mapper keeps
 // up to 4 px, and under squared errors that tail of mismatched or coarse keypoints sets the
 // poses (docs/cameras.md, "The tail of the observations").
+// The same bound clips a left-out photo's residuals where the principal point is judged by
+// prediction.
 constexpr double kMaxReprojectionErrorPx = 1;
+
+// A final bundle adjustment that also frees the principal point, written over the raw model
+// only where CheckRefinedPrincipalPoint keeps it, after the same adjustment with the centre and
+// freed on each fold of the photos left out (PhotoFolds); returns the check (keep, report.json's
+// note).
+PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
+  const std::vector<std::string> refine = {"--BundleAdjustment.refine_principal_point", "1"};
+  const SparseModel model = AdjustRawModel(sfm.colmap, sfm.workspace, refine, "refine", sfm.progress);
+  const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
+  const double clip_px = kMaxReprojectionErrorPx * ExtractionScale(raw, sfm.options.quality);
+  std::vector<FoldPrediction> folds;
+  for (const std::vector<std::string>& left_out : PhotoFolds(raw, kPrincipalPointFolds)) {
+    const SparseModel rest = SelectImages(raw, {left_out.begin(), left_out.end()}, false);
+    const SparseModel centre = AdjustModel(sfm.colmap, sfm.workspace, rest, {}, "predict_centre", sfm.progress);
+    const SparseModel freed = AdjustModel(sfm.colmap, sfm.workspace, rest, refine, "predict_freed", sfm.progress);
+    folds.push_back({LeftOutPhotoError(centre, raw, left_out, clip_px), LeftOutPhotoError(freed, raw, left_out, clip_px),
+                     freed.Cameras()});
+  }
+  const PrincipalPointCheck check = CheckRefinedPrincipalPoint(model, folds, sfm.options);
+  if (check.keep) WriteSparseModel(model, sfm.workspace.RawModel(), SparseFormat::kBinary);
+  return check;
+}
 
 size_t Observations(const SparseModel& model) {
   size_t observations = 0;
@@ -169,13 +187,7 @@ size_t Observations(const SparseModel& model) {
 // (intrinsics held where they are fixed); returns report.json's note.
 std::string FilterAndAdjustRawModel(const SfmContext& sfm) {
   const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
-  // Keypoints of photos SIFT saw downscaled are that much coarser in the photos' pixels.
-  const double extracted_px = SettingsFor(sfm.options.quality).max_image_size;
-  double scale = 1;
-  for (const Camera& camera : raw.Cameras()) {
-    scale = std::max(scale, static_cast<double>(std::max(camera.width, camera.height)) / extracted_px);
-  }
-  const double threshold_px = kMaxReprojectionErrorPx * scale;
+  const double threshold_px = kMaxReprojectionErrorPx * ExtractionScale(raw, sfm.options.quality);
   const SparseModel filtered = RunOnRawModel(sfm.colmap, sfm.workspace, "point_filtering",
                                              {"--max_reproj_error", std::to_string(threshold_px)}, "filter", 0,
                                              sfm.progress);
@@ -411,7 +423,7 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
       .Add(refine_principal_point)
       .Add(sfm.known ? HashFolder(sfm.options.known_cameras) : 0);
   // Only a refining mapper's key changed with the principal point's check.
-  if (refine_principal_point) hasher.Add("checked on parts of the points");
+  if (refine_principal_point) hasher.Add("checked by predicting left-out photos");
   // The incremental mapper keeps the keys it had before there was a choice.
   if (hierarchical) {
     hasher.Add("hierarchical").Add(static_cast<uint64_t>(sfm.options.hierarchical_cluster_images)).Add("adjusted-2");

@@ -206,27 +206,6 @@ TEST(SparseModel, SelectImagesKeepsTheirCamerasAndThePointsTwoOfThemSee) {
   for (const Point2D& point : c_and_d.ImageById(9).points2d) EXPECT_EQ(point.point3d_id, kInvalidPoint3DId);
 }
 
-TEST(SparseModel, SelectPointsKeepsEveryImageObservingOnlyThem) {
-  const SparseModel model = MakeModel();
-  for (size_t first : {0u, 1u}) {
-    const SparseModel part = SelectPoints(model, first, 2);
-    std::vector<uint64_t> ids;
-    for (const Point3D& point : part.Points3D()) ids.push_back(point.id);
-    EXPECT_EQ(ids, first == 0 ? std::vector<uint64_t>({4, kBigPointId, 12}) : std::vector<uint64_t>({1, 10}));
-    EXPECT_EQ(part.Cameras().size(), model.Cameras().size());
-    ASSERT_EQ(part.Images().size(), model.Images().size());
-    for (size_t i = 0; i < model.Images().size(); ++i) {
-      const std::vector<Point2D>& before = model.Images()[i].points2d;
-      const std::vector<Point2D>& after = part.Images()[i].points2d;
-      ASSERT_EQ(after.size(), before.size());  // Keypoints stay, for colmap's ids.
-      for (size_t k = 0; k < after.size(); ++k) {
-        const bool kept = std::find(ids.begin(), ids.end(), before[k].point3d_id) != ids.end();
-        EXPECT_EQ(after[k].point3d_id, kept ? before[k].point3d_id : kInvalidPoint3DId);
-      }
-    }
-  }
-}
-
 TEST(SparseModel, DetectsTheFormatFromTheFilesPresent) {
   const TempDir dir;
   EXPECT_EQ(DetectSparseFormat(dir.Path() / "model"), std::nullopt);
