@@ -62,6 +62,8 @@ class Workspace {
   std::filesystem::path RefinedModelScratch() const { return Sfm() / "refined.tmp"; }
   // A part of the raw model adjusted apart (the principal point's check, pipeline/sfm_policy.h).
   std::filesystem::path PartialModelScratch() const { return Sfm() / "partial.tmp"; }
+  // The cameras' uncertainty that check measured (pipeline/camera_uncertainty.h), where it ran.
+  std::filesystem::path CameraUncertainty() const { return Sfm() / "camera_uncertainty.json"; }
 
   // Depth maps at the depth stage's working size (ReadDepthExrAt reads them at the photo's):
   // depth/<stem>.exr and depth/<stem>.confidence.exr.

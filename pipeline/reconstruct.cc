@@ -111,6 +111,8 @@ nlohmann::json ReportJson(const ReconstructSummary& summary) {
             {"focal_rms_ratio", plausibility.focal_rms_ratio},
             {"well_constrained_image_share", plausibility.well_constrained_image_share},
             {"problems", plausibility.problems}}},
+          {"camera_uncertainty",
+           summary.camera_uncertainty ? ToJson(*summary.camera_uncertainty) : nlohmann::json()},
           {"depth", summary.depth ? nlohmann::json(*summary.depth) : nlohmann::json()},
           {"mesh", summary.mesh ? nlohmann::json(*summary.mesh) : nlohmann::json()},
           {"depth_resolution", summary.depth_resolution},
@@ -305,6 +307,10 @@ ReconstructSummary Reconstruct(const fs::path& photos_dir, const fs::path& works
     return summary;
   }
   summary.stages = graph.Records();  // The report a --strict failure writes lists them.
+  if (fs::exists(paths.CameraUncertainty())) {
+    summary.camera_uncertainty = ReadCameraUncertainty(paths.CameraUncertainty());
+    summary.notes.push_back(Describe(*summary.camera_uncertainty));
+  }
   std::string undistort_key;
   {  // The raw model (every photo's keypoints) is not kept through the dense stages.
     const SparseModel raw_model = CheckRawModel(sfm, summary);

@@ -12,6 +12,7 @@
 #include "mesh/poisson.h"
 #include "mvs/mvs.h"
 #include "pipeline/reconstruct_options.h"
+#include "pipeline/camera_uncertainty.h"
 #include "pipeline/stage_graph.h"
 #include "sfm/photo_set.h"
 #include "sfm/plausibility.h"
@@ -37,6 +38,8 @@ struct ReconstructSummary {
   double mean_track_length = 0;
   double mean_reprojection_error_px = 0;
   PlausibilityReport plausibility;
+  // How well the photos determine the cameras, where the principal point's check measured it.
+  std::optional<CameraUncertainty> camera_uncertainty;
   // Multi-view stereo per view: source views chosen, depth range, valid shares (as written
   // to <ws>/depth/views.json); absent when depth was not estimated.
   std::optional<MvsSummary> depth;

@@ -289,28 +289,6 @@ Eigen::Vector2d ImageCentre(const Camera& camera) {
   return {0.5 * static_cast<double>(camera.width), 0.5 * static_cast<double>(camera.height)};
 }
 
-const Camera& CameraWithId(const std::vector<Camera>& cameras, uint32_t id) {
-  for (const Camera& camera : cameras) {
-    if (camera.id == id) return camera;
-  }
-  throw InternalError("no camera " + std::to_string(id) + " in a fold's adjustment");
-}
-
-// The standard deviation of camera `id`'s refined principal point (pixels, per axis) by the
-// jackknife over the folds: each fold's estimate leaves out 1/K of the photos, and the
-// estimates' scatter times (K - 1) / K is the variance of the whole's.
-double JackknifeDeviation(uint32_t id, const std::vector<FoldPrediction>& folds) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const FoldPrediction& fold : folds) mean += PrincipalPoint(CameraWithId(fold.freed_cameras, id));
-  const double k = static_cast<double>(folds.size());
-  mean /= k;
-  double squares = 0;
-  for (const FoldPrediction& fold : folds) {
-    squares += (PrincipalPoint(CameraWithId(fold.freed_cameras, id)) - mean).squaredNorm();
-  }
-  return std::sqrt((k - 1) / k * squares / 2);
-}
-
 // The folds' left-out reprojection error together: the RMS over all their observations.
 double PooledRms(const std::vector<FoldPrediction>& folds, LeftOutError FoldPrediction::*side) {
   double squares = 0;
@@ -325,27 +303,29 @@ double PooledRms(const std::vector<FoldPrediction>& folds, LeftOutError FoldPred
 
 }  // namespace
 
+bool PrincipalPointDrifted(const SparseModel& refined, const ReconstructOptions& options) {
+  return std::any_of(refined.Cameras().begin(), refined.Cameras().end(), [&](const Camera& camera) {
+    return PrincipalPointOffset(camera) > options.max_refined_principal_point_offset;
+  });
+}
+
 PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<FoldPrediction>& folds,
-                                               const ReconstructOptions& options) {
-  if (folds.size() < 2) throw InternalError("CheckRefinedPrincipalPoint needs two folds or more");
-  // The camera farthest off-centre, and the one whose offset is least certain.
-  double worst_offset = 0, deviation_px = 0, least_significance = HUGE_VAL;
+                                               double deviation_px, const ReconstructOptions& options) {
+  // The camera farthest off-centre, and the one least far in standard deviations.
+  double worst_offset = 0, least_significance = HUGE_VAL;
   for (const Camera& camera : refined.Cameras()) {
     worst_offset = std::max(worst_offset, PrincipalPointOffset(camera));
-    const double deviation = JackknifeDeviation(camera.id, folds);
-    const double significance = (PrincipalPoint(camera) - ImageCentre(camera)).norm() / std::max(deviation, 1e-9);
-    if (significance < least_significance) {
-      least_significance = significance;
-      deviation_px = deviation;
-    }
+    least_significance = std::min(
+        least_significance, (PrincipalPoint(camera) - ImageCentre(camera)).norm() / std::max(deviation_px, 1e-9));
   }
   char note[400];
-  if (worst_offset > options.max_refined_principal_point_offset) {
+  if (PrincipalPointDrifted(refined, options)) {
     std::snprintf(note, sizeof(note),
                   "principal point kept at the image centre: the refined one drifted %.1f%% of the image size "
                   "off-centre (not observable in these photos)", 100 * worst_offset);
     return {false, note};
   }
+  if (folds.size() < 2) throw InternalError("CheckRefinedPrincipalPoint needs two folds or more");
   const double centre_px = PooledRms(folds, &FoldPrediction::centre);
   const double freed_px = PooledRms(folds, &FoldPrediction::freed);
   const double gain = 1 - freed_px / std::max(centre_px, 1e-12);

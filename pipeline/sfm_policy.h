@@ -135,20 +135,23 @@ std::vector<std::vector<std::string>> PhotoFolds(const SparseModel& model, size_
 
 // One fold of the cross-validation by photos (sfm/photo_prediction.h): the reprojection error of
 // the photos it left out, predicted by the other photos adjusted with the principal point at the
-// centre and freed, and the cameras of the freed adjustment.
+// centre and freed.
 struct FoldPrediction {
   LeftOutError centre;
   LeftOutError freed;
-  std::vector<Camera> freed_cameras;
 };
 
+// Whether a refined principal point lies past `options.max_refined_principal_point_offset` of
+// the image size from the centre: drifted where the photos do not show it.
+bool PrincipalPointDrifted(const SparseModel& refined, const ReconstructOptions& options);
+
 // Whether a model whose principal points were refined is kept, and report.json's note saying
-// which and why. Kept where every camera's refined principal point is within
-// `options.max_refined_principal_point_offset` of the image centre and the refinement predicts
+// which and why. Kept where the point has not drifted (PrincipalPointDrifted; then `folds` may
+// be empty) and the refinement predicts
 // the photos left out of it (`folds`) better than the centre does: by the share
 // `options.min_principal_point_prediction_gain` of their reprojection error, or by less where
-// the point lies `options.min_principal_point_deviations` standard deviations off the centre
-// (the jackknife's over the folds). Otherwise the centre stays, as COLMAP keeps it by default:
+// the point lies `options.min_principal_point_deviations` times `deviation_px` (its standard
+// deviation, camera_uncertainty.h) off the centre. Otherwise the centre stays, as COLMAP keeps it by default:
 // along a narrow arc a shifted principal point trades against the rotations, fits the photos
 // it was adjusted on and predicts no others.
 struct PrincipalPointCheck {
@@ -156,6 +159,6 @@ struct PrincipalPointCheck {
   std::string note;
 };
 PrincipalPointCheck CheckRefinedPrincipalPoint(const SparseModel& refined, const std::vector<FoldPrediction>& folds,
-                                               const ReconstructOptions& options);
+                                               double deviation_px, const ReconstructOptions& options);
 
 }  // namespace parallax

@@ -212,6 +212,12 @@ TEST(HeldOut, RealPhotosPrincipalPointMovesOnlyWhereThePhotosShowIt) {
   const Camera centred_camera = ReadSparseModel(dir.Path() / "centred ws" / "sparse").Cameras().at(0);
   EXPECT_LT(std::abs(centred_camera.PrincipalX() - 380.0), 0.003 * 760) << centred.output;
   EXPECT_LT(std::abs(centred_camera.PrincipalY() - 251.5), 0.003 * 503) << centred.output;
+  // The cameras' uncertainty, by the jackknife over the folds of the principal point's check:
+  // the point held, so no deviation of it.
+  const nlohmann::json centred_uncertainty =
+      ReadJson(Workspace(dir.Path() / "centred ws").Report())["reconstruct"]["camera_uncertainty"];
+  EXPECT_EQ(centred_uncertainty["folds"], 8) << centred_uncertainty;
+  EXPECT_EQ(centred_uncertainty["principal_point_px"], 0.0) << centred_uncertainty;
 
   // As taken, with every fourth photo held out: refined towards the calibrated point (7.4 and
   // 8.3 px off-centre at full size), and the held-out photos scored.
@@ -224,6 +230,17 @@ TEST(HeldOut, RealPhotosPrincipalPointMovesOnlyWhereThePhotosShowIt) {
   const Eigen::Vector2d calibrated(760.595 / 2, 503.655 / 2), centre(384, 256);
   const Eigen::Vector2d refined(camera.PrincipalX(), camera.PrincipalY());
   EXPECT_LT((refined - calibrated).norm(), 0.5 * (centre - calibrated).norm()) << taken.output;
+  // Freed, the point's deviation is a few pixels (the refined one lies 3.7 of them off-centre);
+  // the rotations' a few hundredths of a degree (their errors against the calibration are
+  // 0.02-0.04 degrees at full size).
+  const nlohmann::json uncertainty = ReadJson(Workspace(workspace).Report())["reconstruct"]["camera_uncertainty"];
+  std::printf("[ measure ] facade: principal point deviation %.2f px, rotation %.4f deg median\n",
+              uncertainty["principal_point_px"].get<double>(), uncertainty["rotation_deg"]["median"].get<double>());
+  EXPECT_GT(uncertainty["principal_point_px"].get<double>(), 0.3) << uncertainty;
+  EXPECT_LT(uncertainty["principal_point_px"].get<double>(), 5.0) << uncertainty;
+  EXPECT_GT(uncertainty["rotation_deg"]["median"].get<double>(), 0.003) << uncertainty;
+  EXPECT_LT(uncertainty["rotation_deg"]["median"].get<double>(), 0.2) << uncertainty;
+  EXPECT_EQ(uncertainty["rotation_deg"]["photos"].size(), 8u) << uncertainty;
   EXPECT_EQ(ImageNames(Workspace(workspace).HeldOut().Sparse()), std::vector<std::string>({"0000.jpg", "0004.jpg"}));
   const CliResult evaluated = RunParallax("evaluate " + Quote(workspace.string()));
   ASSERT_EQ(evaluated.exit_code, 0) << evaluated.output;

@@ -236,57 +236,52 @@ TEST(PhotoFolds, EveryKthPhotoByName) {
   EXPECT_EQ(PhotoFolds(model, 8), Folds({{"a"}, {"b"}, {"c"}, {"d"}, {"e"}}));
 }
 
-// Four folds whose freed adjustments put the principal point at (x - dx, y) and (x + dx, y)
-// alternately and predict the left-out photos' 100 observations at `freed_px` against
-// `centre_px`.
-std::vector<FoldPrediction> FoldsAt(double x, double dx, double y, double centre_px, double freed_px) {
-  std::vector<FoldPrediction> folds;
-  for (int i = 0; i < 4; ++i) {
-    folds.push_back({{centre_px, 100}, {freed_px, 100}, OneCameraAt(i % 2 ? x + dx : x - dx, y).Cameras()});
-  }
-  return folds;
+// Four folds predicting the left-out photos' 100 observations each at `freed_px` with the
+// point freed against `centre_px` at the centre.
+std::vector<FoldPrediction> FoldsAt(double centre_px, double freed_px) {
+  return std::vector<FoldPrediction>(4, {{centre_px, 100}, {freed_px, 100}});
 }
 
 TEST(CheckRefinedPrincipalPoint, APointThatPredictsTheLeftOutPhotosIsKept) {
   const ReconstructOptions options;
-  // 40 px off; four folds 4 px either side: the jackknife's deviation sqrt(3/4 * 64 / 2) = 4.9 px.
-  const PrincipalPointCheck kept =
-      CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(540, 4, 250, 0.5, 0.45), options);
+  const PrincipalPointCheck kept = CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(0.5, 0.45), 4.9, options);
   EXPECT_TRUE(kept.keep);
   EXPECT_EQ(kept.note,
             "principal point refined in a final bundle adjustment: the refined one is 4.0% off-centre, 8.2 standard "
             "deviations (4.9 px by the jackknife over 4 folds of the photos), and predicts the photos left out of it "
             "at 0.450 px against 0.500 px from the centre (better in 4 of the folds)");
-  // Either side of the 0.3% gain the option asks for, with the point within three deviations
-  // of the centre (folds 20 px either side): kept, then not.
-  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(540, 20, 250, 0.5, 0.4984), options).keep);
-  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(540, 20, 250, 0.5, 0.4986), options).keep);
+  // Either side of the 0.3% gain the option asks for, 2 deviations off-centre: kept, then not.
+  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(0.5, 0.4984), 20, options).keep);
+  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(540, 250), FoldsAt(0.5, 0.4986), 20, options).keep);
 }
 
-// As on photos undistorted to a centred pinhole along a narrow arc: 2.9% off, but scattered
-// widely over the folds and no better at predicting the photos it was not adjusted on.
+// As on photos undistorted to a centred pinhole along a narrow arc: 2.9% off, but uncertain
+// over the folds and no better at predicting the photos it was not adjusted on.
 TEST(CheckRefinedPrincipalPoint, APointThatPredictsNoBetterStaysAtTheCentre) {
   const ReconstructOptions options;
   const PrincipalPointCheck rejected =
-      CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(529, 20, 250, 0.5, 0.4995), options);
+      CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(0.5, 0.4995), 24.5, options);
   EXPECT_FALSE(rejected.keep);
   EXPECT_EQ(rejected.note,
             "principal point kept at the image centre: the refined one is 2.9% off-centre, 1.2 standard deviations "
             "(24.5 px by the jackknife over 4 folds of the photos), and predicts the photos left out of it at "
             "0.499 px against 0.500 px from the centre (better in 4 of the folds)");
   // Three deviations off the centre, a smaller gain suffices; none does not.
-  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(529, 1, 250, 0.5, 0.4995), options).keep);
-  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(529, 1, 250, 0.5, 0.5005), options).keep);
-  std::vector<FoldPrediction> one_fold = FoldsAt(529, 1, 250, 0.5, 0.4);
-  one_fold.resize(1);
-  EXPECT_THROW(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), one_fold, options), InternalError);
+  EXPECT_TRUE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(0.5, 0.4995), 9.6, options).keep);
+  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(0.5, 0.4995), 9.7, options).keep);
+  EXPECT_FALSE(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), FoldsAt(0.5, 0.5005), 1.2, options).keep);
+  EXPECT_THROW(CheckRefinedPrincipalPoint(OneCameraAt(529, 250), {{{0.5, 100}, {0.4, 100}}}, 1, options),
+               InternalError);
 }
 
 TEST(CheckRefinedPrincipalPoint, APointDriftedPastTheLimitStaysAtTheCentre) {
   ReconstructOptions options;
   options.max_refined_principal_point_offset = 0.05;
   const SparseModel drifted = OneCameraAt(500, 290);  // 8% of the height off-centre.
-  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(drifted, FoldsAt(500, 0, 290, 0.5, 0.3), options);
+  EXPECT_TRUE(PrincipalPointDrifted(drifted, options));
+  EXPECT_FALSE(PrincipalPointDrifted(OneCameraAt(520, 260), options));  // 2% off-centre.
+  // The folds are not adjusted with the point freed: there are none to look at.
+  const PrincipalPointCheck rejected = CheckRefinedPrincipalPoint(drifted, {}, 0, options);
   EXPECT_FALSE(rejected.keep);
   EXPECT_EQ(rejected.note,
             "principal point kept at the image centre: the refined one drifted 8.0% of the image size off-centre "
