@@ -146,14 +146,13 @@ struct FoldPrediction {
 bool PrincipalPointDrifted(const SparseModel& refined, const ReconstructOptions& options);
 
 // Whether a model whose principal points were refined is kept, and report.json's note saying
-// which and why. Kept where the point has not drifted (PrincipalPointDrifted; then `folds` may
-// be empty) and the refinement predicts
-// the photos left out of it (`folds`) better than the centre does: by the share
-// `options.min_principal_point_prediction_gain` of their reprojection error, or by less where
-// the point lies `options.min_principal_point_deviations` times `deviation_px` (its standard
-// deviation, camera_uncertainty.h) off the centre. Otherwise the centre stays, as COLMAP keeps it by default:
-// along a narrow arc a shifted principal point trades against the rotations, fits the photos
-// it was adjusted on and predicts no others.
+// which and why. Kept where the point has not drifted (PrincipalPointDrifted; `folds` may then
+// be empty) and predicts the photos left out of it (`folds`) better than the centre does: by
+// the share `options.min_principal_point_prediction_gain` of their reprojection error, or by
+// less where it lies `options.min_principal_point_deviations` times `deviation_px` (its
+// standard deviation, camera_uncertainty.h) off the centre. Otherwise the centre stays, as
+// COLMAP keeps it by default: along a narrow arc a shifted principal point trades against the
+// rotations, fits the photos it was adjusted on and predicts no others.
 struct PrincipalPointCheck {
   bool keep = false;
   std::string note;

@@ -189,14 +189,15 @@ PrincipalPointCheck RefinePrincipalPoint(const SfmContext& sfm) {
   std::vector<SparseModel> centred_folds, freed_folds;
   for (const std::vector<std::string>& left_out : PhotoFolds(raw, kPrincipalPointFolds)) {
     const std::set<std::string> names(left_out.begin(), left_out.end());
-    const SparseModel centre =
-        AdjustModel(sfm.colmap, sfm.workspace, SelectImages(raw, names, false), centred, "predict_centre", sfm.progress);
+    const SparseModel centre = AdjustModel(sfm.colmap, sfm.workspace, SelectImages(raw, names, false), centred,
+                                           "predict_centre", sfm.progress);
     centred_folds.push_back(CamerasAndPoses(centre));
     if (drifted) continue;
     // From the whole's refined point, which the fold's is near.
     const SparseModel freed = AdjustModel(sfm.colmap, sfm.workspace, SelectImages(model, names, false),
                                           freed_options, "predict_freed", sfm.progress);
-    folds.push_back({LeftOutPhotoError(centre, raw, left_out, clip_px), LeftOutPhotoError(freed, raw, left_out, clip_px)});
+    folds.push_back(
+        {LeftOutPhotoError(centre, raw, left_out, clip_px), LeftOutPhotoError(freed, raw, left_out, clip_px)});
     freed_folds.push_back(CamerasAndPoses(freed));
   }
   const CameraUncertainty freed = drifted ? CameraUncertainty{} : JackknifeUncertainty(model, freed_folds);
