@@ -5,15 +5,13 @@
 #include <optional>
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 
 #include "core/error.h"
+#include "sfm/reprojection_residual.h"
 
 namespace parallax {
 namespace {
 
-// The residual of a point behind the camera or outside the lens model's range, in pixels.
-constexpr double kUnprojectedResidualPx = 1e3;
 constexpr int kResectionMaxIterations = 50;
 
 // One observation: parameter blocks cam_from_world rotation (w, x, y, z) and translation.
@@ -23,13 +21,7 @@ struct PoseResidual {
   Eigen::Vector2d observed;
 
   bool operator()(const double* rotation, const double* translation, double* residual) const {
-    double rotated[3];
-    ceres::QuaternionRotatePoint(rotation, point.data(), rotated);
-    const Eigen::Vector3d point_in_cam(rotated[0] + translation[0], rotated[1] + translation[1],
-                                       rotated[2] + translation[2]);
-    const std::optional<Eigen::Vector2d> pixel = camera->Project(point_in_cam);
-    residual[0] = pixel ? (*pixel)[0] - observed[0] : kUnprojectedResidualPx;
-    residual[1] = pixel ? (*pixel)[1] - observed[1] : kUnprojectedResidualPx;
+    ProjectionResidual(*camera, rotation, translation, point.data(), observed, residual);
     return true;
   }
 };
@@ -38,7 +30,7 @@ struct PoseResidual {
 double ReprojectionError(const Camera& camera, const Rigid3d& cam_from_world, const Eigen::Vector3d& point,
                          const Eigen::Vector2d& pixel) {
   const std::optional<Eigen::Vector2d> projected = camera.Project(cam_from_world * point);
-  return projected ? (*projected - pixel).norm() : kUnprojectedResidualPx;
+  return projected ? (*projected - pixel).norm() : kUnprojectableResidualPx;
 }
 
 }  // namespace

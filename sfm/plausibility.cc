@@ -13,11 +13,11 @@
 #include <unordered_set>
 
 #include <ceres/ceres.h>
-#include <ceres/rotation.h>
 
 #include "core/error.h"
 #include "core/statistics.h"
 #include "core/check.h"
+#include "sfm/reprojection_residual.h"
 
 namespace parallax {
 namespace {
@@ -28,9 +28,6 @@ constexpr size_t kMaxTrackForAngles = 16;
 // is already a solution when the focal length is free), so it never hides a problem.
 constexpr size_t kMaxTrackForFocalTest = 16;
 constexpr int kFocalTestIterations = 25;
-// Residual for a point the focal test cannot project (behind a camera): large and constant,
-// so the solver moves away from it instead of failing (a failed evaluation ends the solve).
-constexpr double kUnprojectableResidualPx = 1e3;
 
 __attribute__((format(printf, 1, 2))) std::string Format(const char* format, ...) {
   char text[512];
@@ -75,13 +72,7 @@ struct ReprojectionResidual {
   bool operator()(double const* const* blocks, double* residual) const {
     Camera scratch = camera;
     std::copy(blocks[3], blocks[3] + scratch.params.size(), scratch.params.begin());
-    double rotated[3];
-    ceres::QuaternionRotatePoint(blocks[0], blocks[2], rotated);
-    const Eigen::Vector3d point_in_cam(rotated[0] + blocks[1][0], rotated[1] + blocks[1][1],
-                                       rotated[2] + blocks[1][2]);
-    const std::optional<Eigen::Vector2d> pixel = scratch.Project(point_in_cam);
-    residual[0] = pixel ? (*pixel)[0] - observed[0] : kUnprojectableResidualPx;
-    residual[1] = pixel ? (*pixel)[1] - observed[1] : kUnprojectableResidualPx;
+    ProjectionResidual(scratch, blocks[0], blocks[1], blocks[2], observed, residual);
     return true;
   }
 };
