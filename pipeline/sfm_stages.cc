@@ -495,9 +495,9 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
       WriteSparseModel(AdjustRawModel(sfm.colmap, paths, {}, "adjust", sfm.progress), paths.RawModel(),
                        SparseFormat::kBinary);
     }
-    // After the principal point's check, which needs the whole tail to see its scatter (on
-    // entry-p10 the filtered model moved the point from 0.8% to 0.6% off-centre, and the
-    // cameras with it).
+    // After the principal point's check: filtered first, entry-p10's point moved from 0.8% to
+    // 0.6% off-centre and the cameras with it (measured with the check by parts of the points,
+    // which needed the tail to see the point's scatter; not measured again since).
     if (!sfm.known) notes.push_back(FilterAndAdjustRawModel(sfm));
     if (key_photos) {
       WriteSparseModel(RegisterOtherPhotos(sfm.colmap, paths,
