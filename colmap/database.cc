@@ -1,8 +1,10 @@
 #include "colmap/database.h"
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <set>
 #include <string>
 
 #include <sqlite3.h>
@@ -44,15 +46,40 @@ Statement Prepare(const std::filesystem::path& database, sqlite3* connection, co
   return Statement(raw, &sqlite3_finalize);
 }
 
+// Runs `query` on an open connection, calling `row` for each result row. Throws BadInputError
+// naming the file if it cannot be queried or read.
+void ForEachRow(const std::filesystem::path& database, sqlite3* connection, const char* query,
+                const std::function<void(sqlite3_stmt*)>& row) {
+  const Statement statement = Prepare(database, connection, query, "read");
+  int step;
+  while ((step = sqlite3_step(statement.get())) == SQLITE_ROW) row(statement.get());
+  if (step != SQLITE_DONE) Fail(database, connection, "read");
+}
+
 // Runs `query` on the database read-only, calling `row` for each result row. Throws
 // BadInputError naming the file if it cannot be opened, queried or read.
 void ForEachRow(const std::filesystem::path& database, const char* query,
                 const std::function<void(sqlite3_stmt*)>& row) {
   const Connection connection = Open(database, SQLITE_OPEN_READONLY, "read");
-  const Statement statement = Prepare(database, connection.get(), query, "read");
-  int step;
-  while ((step = sqlite3_step(statement.get())) == SQLITE_ROW) row(statement.get());
-  if (step != SQLITE_DONE) Fail(database, connection.get(), "read");
+  ForEachRow(database, connection.get(), query, row);
+}
+
+// Runs the statement `sql`, which returns no rows. Throws BadInputError naming the file if it fails.
+void Execute(const std::filesystem::path& database, sqlite3* connection, const std::string& sql) {
+  if (sqlite3_exec(connection, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) {
+    Fail(database, connection, sql.c_str(), "write");
+  }
+}
+
+// Steps a prepared statement that returns no rows, then resets it for the next bindings.
+void StepOnce(const std::filesystem::path& database, sqlite3* connection, sqlite3_stmt* statement,
+              const char* what) {
+  if (sqlite3_step(statement) != SQLITE_DONE) Fail(database, connection, what, "write");
+  sqlite3_reset(statement);
+}
+
+int64_t PairId(uint32_t first, uint32_t second) {
+  return int64_t{std::min(first, second)} * kMaxImageId + std::max(first, second);
 }
 
 std::string TextColumn(sqlite3_stmt* statement, int column) {
@@ -61,6 +88,40 @@ std::string TextColumn(sqlite3_stmt* statement, int column) {
 }
 
 }  // namespace
+
+void NumberImagesByName(const std::filesystem::path& database) {
+  const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
+  int64_t matched = 0;
+  ForEachRow(database, connection.get(),
+             "SELECT (SELECT COUNT(*) FROM matches) + (SELECT COUNT(*) FROM two_view_geometries)",
+             [&](sqlite3_stmt* row) { matched = sqlite3_column_int64(row, 0); });
+  if (matched > 0) {
+    throw BadInputError("cannot number the images of the COLMAP database " + database.string() +
+                        " by name: it holds matches already");
+  }
+  std::vector<int64_t> ids;  // In name order (SQLite compares text bytewise, as std::string does).
+  ForEachRow(database, connection.get(), "SELECT image_id FROM images ORDER BY name",
+             [&](sqlite3_stmt* row) { ids.push_back(sqlite3_column_int64(row, 0)); });
+  bool numbered = true;
+  for (size_t i = 0; i < ids.size(); ++i) numbered = numbered && ids[i] == static_cast<int64_t>(i) + 1;
+  if (numbered) return;
+  // Every id is first moved past the largest, so that no new number meets an old one.
+  const int64_t offset = *std::max_element(ids.begin(), ids.end());
+  Execute(database, connection.get(), "BEGIN");
+  for (const char* table : {"images", "keypoints", "descriptors"}) {
+    Execute(database, connection.get(),
+            std::string("UPDATE ") + table + " SET image_id = image_id + " + std::to_string(offset));
+    const Statement renumber = Prepare(database, connection.get(),
+                                       (std::string("UPDATE ") + table + " SET image_id = ? WHERE image_id = ?").c_str(),
+                                       "write");
+    for (size_t i = 0; i < ids.size(); ++i) {
+      sqlite3_bind_int64(renumber.get(), 1, static_cast<int64_t>(i) + 1);
+      sqlite3_bind_int64(renumber.get(), 2, ids[i] + offset);
+      StepOnce(database, connection.get(), renumber.get(), "number the images");
+    }
+  }
+  Execute(database, connection.get(), "COMMIT");
+}
 
 std::map<std::string, DatabaseImage> ReadDatabaseImages(const std::filesystem::path& database) {
   std::map<std::string, DatabaseImage> images;
@@ -147,20 +208,13 @@ std::vector<RawMatches> ReadRawMatches(const std::filesystem::path& database) {
 
 void WriteRawMatches(const std::filesystem::path& database, const std::vector<RawMatches>& pairs) {
   const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
-  auto execute = [&](const char* sql) {
-    if (sqlite3_exec(connection.get(), sql, nullptr, nullptr, nullptr) != SQLITE_OK) {
-      Fail(database, connection.get(), sql, "write");
-    }
-  };
-  execute("BEGIN");
+  Execute(database, connection.get(), "BEGIN");
   {
     const Statement insert =
         Prepare(database, connection.get(),
                 "INSERT OR REPLACE INTO matches (pair_id, rows, cols, data) VALUES (?, ?, ?, ?)", "write");
     for (const RawMatches& pair : pairs) {
       const bool swap = pair.first_image_id > pair.second_image_id;
-      const int64_t low = swap ? pair.second_image_id : pair.first_image_id;
-      const int64_t high = swap ? pair.first_image_id : pair.second_image_id;
       std::vector<uint32_t> columns;  // colmap's layout: rows of (low's feature, high's feature).
       columns.reserve(2 * pair.matches.size());
       for (const auto& match : pair.matches) {
@@ -168,15 +222,62 @@ void WriteRawMatches(const std::filesystem::path& database, const std::vector<Ra
         columns.push_back(match[swap ? 0 : 1]);
       }
       sqlite3_stmt* statement = insert.get();
-      sqlite3_bind_int64(statement, 1, low * kMaxImageId + high);
+      sqlite3_bind_int64(statement, 1, PairId(pair.first_image_id, pair.second_image_id));
       sqlite3_bind_int64(statement, 2, static_cast<int64_t>(pair.matches.size()));
       sqlite3_bind_int64(statement, 3, 2);
       sqlite3_bind_blob64(statement, 4, columns.data(), columns.size() * sizeof(uint32_t), SQLITE_TRANSIENT);
-      if (sqlite3_step(statement) != SQLITE_DONE) Fail(database, connection.get(), "insert matches", "write");
-      sqlite3_reset(statement);
+      StepOnce(database, connection.get(), statement, "insert matches");
     }
   }
-  execute("COMMIT");
+  Execute(database, connection.get(), "COMMIT");
+}
+
+void MarkOtherPairsVerified(const std::filesystem::path& database,
+                            const std::vector<std::array<uint32_t, 2>>& pairs) {
+  std::set<int64_t> kept;
+  for (const auto& [first, second] : pairs) kept.insert(PairId(first, second));
+  const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
+  std::vector<uint32_t> ids;
+  ForEachRow(database, connection.get(), "SELECT image_id FROM images",
+             [&](sqlite3_stmt* row) { ids.push_back(static_cast<uint32_t>(sqlite3_column_int64(row, 0))); });
+  Execute(database, connection.get(), "BEGIN");
+  {
+    const Statement mark = Prepare(database, connection.get(),
+                                   "INSERT OR IGNORE INTO two_view_geometries (pair_id, rows, cols, data, config) "
+                                   "VALUES (?, 0, 2, NULL, 0)",
+                                   "write");
+    for (size_t i = 0; i < ids.size(); ++i) {
+      for (size_t j = i + 1; j < ids.size(); ++j) {
+        const int64_t pair_id = PairId(ids[i], ids[j]);
+        if (kept.count(pair_id)) continue;
+        sqlite3_bind_int64(mark.get(), 1, pair_id);
+        StepOnce(database, connection.get(), mark.get(), "mark pairs verified");
+      }
+    }
+  }
+  Execute(database, connection.get(), "COMMIT");
+}
+
+void GatherVerifiedPairs(const std::filesystem::path& database, const std::filesystem::path& part,
+                         const std::vector<std::array<uint32_t, 2>>& pairs) {
+  const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
+  {
+    const Statement attach = Prepare(database, connection.get(), "ATTACH DATABASE ? AS part", "write");
+    sqlite3_bind_text(attach.get(), 1, part.c_str(), -1, SQLITE_TRANSIENT);
+    StepOnce(part, connection.get(), attach.get(), "attach");
+  }
+  Execute(database, connection.get(), "BEGIN");
+  {
+    const Statement copy = Prepare(database, connection.get(),
+                                   "INSERT OR REPLACE INTO main.two_view_geometries "
+                                   "SELECT * FROM part.two_view_geometries WHERE pair_id = ?",
+                                   "write");
+    for (const auto& [first, second] : pairs) {
+      sqlite3_bind_int64(copy.get(), 1, PairId(first, second));
+      StepOnce(database, connection.get(), copy.get(), "gather verified pairs");
+    }
+  }
+  Execute(database, connection.get(), "COMMIT");
 }
 
 }  // namespace parallax

@@ -1,8 +1,8 @@
 #pragma once
 // Reads what parallax needs from a COLMAP database (SQLite): which id COLMAP gave each image
-// (COLMAP's multi-threaded feature extractor assigns ids in the order images finish, not in
-// name order, so a model that must match the database (point_triangulator) takes its ids
-// from here), and how each matched pair was verified (to say why mapping could not start).
+// (a model that must match the database (point_triangulator) takes its ids from here), and how
+// each matched pair was verified (to say why mapping could not start); numbers its images by
+// name, and writes matches and gathers verified pairs for parallax's matching.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -16,6 +16,14 @@ struct DatabaseImage {
   uint32_t image_id = 0;
   uint32_t camera_id = 0;
 };
+
+// Numbers the images 1, 2, ... in name order, their keypoints and descriptors with them, in one
+// transaction. COLMAP's multi-threaded feature extractor numbers images in the order they
+// finish, and the numbers steer the order of matching and the mapper's choices between equals:
+// numbered by name, the same photos give the same database on every run. For a database
+// without matches yet (feature extraction's); throws BadInputError naming the file if it holds
+// matches or cannot be written.
+void NumberImagesByName(const std::filesystem::path& database);
 
 // Image name -> ids. Throws BadInputError naming the file if it cannot be read.
 std::map<std::string, DatabaseImage> ReadDatabaseImages(const std::filesystem::path& database);
@@ -73,5 +81,17 @@ std::vector<RawMatches> ReadRawMatches(const std::filesystem::path& database);
 // transaction: colmap's matchers then verify these pairs without matching them again. Throws
 // BadInputError naming the file if it cannot be written.
 void WriteRawMatches(const std::filesystem::path& database, const std::vector<RawMatches>& pairs);
+
+// Marks every pair of images of `database` except `pairs` (image ids) as verified with no
+// geometry, where it is not verified yet, in one transaction: colmap's matchers then verify
+// `pairs` only. Throws BadInputError naming the file if it cannot be written.
+void MarkOtherPairsVerified(const std::filesystem::path& database,
+                            const std::vector<std::array<uint32_t, 2>>& pairs);
+
+// Copies into `database` the two-view geometries of `pairs` (image ids) that `part` holds (a copy
+// of `database` in which they were verified), in one transaction. Throws BadInputError naming
+// the file that cannot be read or written.
+void GatherVerifiedPairs(const std::filesystem::path& database, const std::filesystem::path& part,
+                         const std::vector<std::array<uint32_t, 2>>& pairs);
 
 }  // namespace parallax

@@ -70,8 +70,12 @@ ProcessResult RunProcess(const std::vector<std::string>& argv,
                          const std::vector<std::string>& extra_environment,
                          const std::function<void(std::string_view line)>& on_line) {
   if (argv.empty()) throw InternalError("RunProcess: empty command line");
+  // Closed on exec: a child started by another thread at the same time must not hold this
+  // pipe's write end, or its reader would wait for that child too.
   int fds[2];
-  if (::pipe(fds) != 0) throw std::runtime_error("cannot create a pipe: " + std::string(std::strerror(errno)));
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
+    throw std::runtime_error("cannot create a pipe: " + std::string(std::strerror(errno)));
+  }
   FileDescriptor read_end(fds[0]), write_end(fds[1]);
 
   posix_spawn_file_actions_t actions;

@@ -1,6 +1,7 @@
 #include "pipeline/sfm_stages.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -9,9 +10,11 @@
 #include <string_view>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "colmap/database.h"
 #include "colmap/raw_model.h"
+#include "colmap/verification.h"
 #include "core/atomic_file.h"
 #include "core/error.h"
 #include "core/interrupt.h"
@@ -60,12 +63,12 @@ std::string HashFileContent(const fs::path& file) {
 struct Matching {
   const SfmContext& sfm;
   fs::path database;
-  std::vector<std::string> common;  // Database and matching options every matcher takes.
+  std::vector<std::string> options;  // Matching options every matcher takes, beside the database.
 
   // Matches each photo with the next in name order and returns the share of those pairs that
   // verified. The pairs stay in the database; the matchers after skip them.
   double MatchConsecutive() const {
-    std::vector<std::string> arguments = common;
+    std::vector<std::string> arguments = Arguments();
     // colmap's overlap counts the image itself: 2 pairs it with the next one only.
     arguments.insert(arguments.end(), {"--SequentialMatching.overlap", "2",
                                        "--SequentialMatching.quadratic_overlap", "0"});
@@ -74,13 +77,13 @@ struct Matching {
   }
 
   void Run(MatcherChoice matcher) const {
-    std::vector<std::string> arguments = common;
+    std::vector<std::string> arguments = Arguments();
     const std::string tree = VocabularyTreeFile(sfm).string();
     const std::string neighbours = std::to_string(sfm.options.retrieval_images);
     switch (matcher) {
       case MatcherChoice::kExhaustive:
-        MatchEveryPair();
-        return Run("exhaustive_matcher", arguments, "matches, verification");
+        return VerifyMatches(sfm.colmap, database, MatchEveryPair(), tbb::this_task_arena::max_concurrency(),
+                             options, sfm.workspace.Log("matches"), "matches, verification", sfm.progress);
       case MatcherChoice::kSequential:
         arguments.insert(arguments.end(),
                          {"--SequentialMatching.overlap", std::to_string(sfm.options.sequential_overlap),
@@ -97,8 +100,8 @@ struct Matching {
   }
 
   // Matches every pair of photos in the database by brute force (sfm/feature_matching.h), pairs
-  // on both cores, and stores the matches: colmap's exhaustive matcher then only verifies them.
-  void MatchEveryPair() const {
+  // on both cores, and stores the matches for colmap to verify. Returns the pairs (image ids).
+  std::vector<std::array<uint32_t, 2>> MatchEveryPair() const {
     const std::vector<DatabaseDescriptors> images = ReadDescriptors(database);
     std::vector<RawMatches> pairs;
     std::vector<std::array<size_t, 2>> indices;
@@ -123,6 +126,15 @@ struct Matching {
       sfm.progress.Update("matches", end, total);
     }
     WriteRawMatches(database, pairs);
+    std::vector<std::array<uint32_t, 2>> ids;
+    for (const RawMatches& pair : pairs) ids.push_back({pair.first_image_id, pair.second_image_id});
+    return ids;
+  }
+
+  std::vector<std::string> Arguments() const {
+    std::vector<std::string> arguments = {"--database_path", database.string()};
+    arguments.insert(arguments.end(), options.begin(), options.end());
+    return arguments;
   }
 
   void Run(const std::string& command, const std::vector<std::string>& arguments,
@@ -328,6 +340,7 @@ Stage FeaturesStage(const SfmContext& sfm, const std::string& photos_key) {
                      static_cast<int>(runs[i].names.size()), sfm.progress);
     }
     fs::remove(run_list);
+    NumberImagesByName(database);
     fs::rename(database, paths.Database());
   };
   return stage;
@@ -399,9 +412,8 @@ Stage MatchesStage(const SfmContext& sfm, const std::string& features_key,
     const fs::path database = paths.Database().string() + ".tmp";
     const TemporaryDatabase temporary(database);
     fs::copy_file(paths.Database(), database, fs::copy_options::overwrite_existing);
-    const Matching matching{sfm, database,
-                            {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
-                             "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"}};
+    const Matching matching{
+        sfm, database, {"--SiftMatching.use_gpu", "0", "--SiftMatching.guided_matching", quality.guided_matching ? "1" : "0"}};
     MatcherChoice matcher = sfm.matcher;
     std::optional<double> consecutive_share;
     if (matcher == MatcherChoice::kAuto) {

@@ -19,7 +19,9 @@
 
 #include "colmap/database.h"
 #include "colmap/runner.h"
+#include "colmap/verification.h"
 #include "core/atomic_file.h"
+#include "core/error.h"
 #include "core/scene_folder.h"
 #include "core/sparse_model.h"
 #include "core/workspace.h"
@@ -37,9 +39,9 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kCourtyard = SourceDir() / "example_images" / "courtyard";
 
-// The courtyard's photos, the i-th under the name `name(i)`.
-void CopyPhotos(const fs::path& folder, const std::function<std::string(int)>& name) {
-  for (int i = 0; i < 24; ++i) {
+// The courtyard's first `count` photos, the i-th under the name `name(i)`.
+void CopyPhotos(const fs::path& folder, const std::function<std::string(int)>& name, int count = 24) {
+  for (int i = 0; i < count; ++i) {
     char photo[16];
     std::snprintf(photo, sizeof(photo), "%04d.png", i);
     fs::copy_file(kCourtyard / "images" / photo, folder / name(i));
@@ -122,6 +124,53 @@ TEST(Matching, AnAutomaticChoiceUpToTheLimitIsExhaustiveAndNeedsNoTree) {
   EXPECT_NE(tree.reason.find("exhaustive matching"), std::string::npos) << tree.reason;
 }
 
+// The courtyard's first six photos in `folder`/photos, their features extracted by colmap into
+// `database` as fast quality does: the last three first, so that the images are numbered out of
+// name order, as colmap's threads may number them (it numbers images in the order they finish).
+void ExtractSixPhotos(const fs::path& folder, const fs::path& database) {
+  const fs::path photos = folder / "photos", list = folder / "image_list.txt";
+  fs::create_directories(photos);
+  for (int i = 0; i < 6; ++i) {
+    const std::string name = "000" + std::to_string(i) + ".png";
+    fs::copy_file(kCourtyard / "images" / name, photos / name);
+  }
+  SilentProgress progress;
+  for (const char* names : {"0003.png\n0004.png\n0005.png\n", "0000.png\n0001.png\n0002.png\n"}) {
+    WriteFileAtomically(list, names);
+    Colmap().Run("feature_extractor",
+                 {"--database_path", database.string(), "--image_path", photos.string(), "--image_list_path",
+                  list.string(), "--ImageReader.single_camera", "1", "--SiftExtraction.use_gpu", "0",
+                  "--SiftExtraction.max_image_size", "1024", "--SiftExtraction.max_num_features", "2048"},
+                 folder / "colmap.log", "features", 3, progress);
+  }
+}
+
+// Each image's descriptors, by name.
+std::map<std::string, std::vector<uint8_t>> DescriptorsByName(const fs::path& database) {
+  std::map<uint32_t, std::string> names;
+  for (const auto& [name, ids] : ReadDatabaseImages(database)) names[ids.image_id] = name;
+  std::map<std::string, std::vector<uint8_t>> descriptors;
+  for (DatabaseDescriptors& image : ReadDescriptors(database)) descriptors[names.at(image.image_id)] = image.data;
+  return descriptors;
+}
+
+// Every pair of the database's images matched by brute force and stored; returns the pairs.
+std::vector<std::array<uint32_t, 2>> MatchEveryPair(const fs::path& database) {
+  const std::vector<DatabaseDescriptors> images = ReadDescriptors(database);
+  std::vector<RawMatches> pairs;
+  std::vector<std::array<uint32_t, 2>> ids;
+  for (size_t i = 0; i < images.size(); ++i) {
+    for (size_t j = i + 1; j < images.size(); ++j) {
+      pairs.push_back({images[i].image_id, images[j].image_id,
+                       MatchSiftFeatures({images[i].data.data(), images[i].rows},
+                                         {images[j].data.data(), images[j].rows})});
+      ids.push_back({images[i].image_id, images[j].image_id});
+    }
+  }
+  WriteRawMatches(database, pairs);
+  return ids;
+}
+
 // Each pair's matches and its verified inliers, by image ids.
 struct PairCounts {
   std::map<std::pair<uint32_t, uint32_t>, std::set<std::array<uint32_t, 2>>> matches;
@@ -144,33 +193,13 @@ PairCounts ReadPairs(const fs::path& database) {
 // other does not (~3%), and as many verify.
 TEST(Matching, BruteForceKeepsWhatColmapsMatcherKeeps) {
   const TempDir folder;
-  const fs::path photos = folder.Path() / "photos";
-  fs::create_directories(photos);
-  for (int i = 0; i < 6; ++i) {
-    const std::string name = "000" + std::to_string(i) + ".png";
-    fs::copy_file(kCourtyard / "images" / name, photos / name);
-  }
-  const Colmap colmap;
-  SilentProgress progress;
   const fs::path theirs = folder.Path() / "colmap.db", ours = folder.Path() / "parallax.db";
   const fs::path log = folder.Path() / "colmap.log";
-  colmap.Run("feature_extractor",
-             {"--database_path", theirs.string(), "--image_path", photos.string(), "--ImageReader.single_camera", "1",
-              "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size", "1024",
-              "--SiftExtraction.max_num_features", "2048"},
-             log, "features", 6, progress);
+  ExtractSixPhotos(folder.Path(), theirs);
   fs::copy_file(theirs, ours);
-  const std::vector<DatabaseDescriptors> images = ReadDescriptors(ours);
-  ASSERT_EQ(images.size(), 6u);
-  std::vector<RawMatches> pairs;
-  for (size_t i = 0; i < images.size(); ++i) {
-    for (size_t j = i + 1; j < images.size(); ++j) {
-      pairs.push_back({images[i].image_id, images[j].image_id,
-                       MatchSiftFeatures({images[i].data.data(), images[i].rows},
-                                         {images[j].data.data(), images[j].rows})});
-    }
-  }
-  WriteRawMatches(ours, pairs);
+  ASSERT_EQ(MatchEveryPair(ours).size(), 15u);
+  const Colmap colmap;
+  SilentProgress progress;
   for (const fs::path& database : {theirs, ours}) {
     colmap.Run("exhaustive_matcher", {"--database_path", database.string(), "--SiftMatching.use_gpu", "0"}, log,
                "matches", 6, progress);
@@ -199,6 +228,98 @@ TEST(Matching, BruteForceKeepsWhatColmapsMatcherKeeps) {
   // 14 or 15 pairs verify, either way: the pair 75 degrees apart is on the edge (~15 inliers).
   EXPECT_GE(parallax_pairs.inliers.size() + 1, colmap_pairs.inliers.size());
   EXPECT_GE(parallax_inliers, colmap_inliers * 97 / 100);
+}
+
+// Numbered by name, each of the six photos keeps its descriptors. Numbered already, a database stays as it is; once it holds matches, it is
+// refused.
+TEST(Database, ImagesAreNumberedByName) {
+  const TempDir folder;
+  const fs::path database = folder.Path() / "database.db";
+  ExtractSixPhotos(folder.Path(), database);
+  const auto before = DescriptorsByName(database);
+  ASSERT_EQ(before.size(), 6u);
+  EXPECT_GT(ReadDatabaseImages(database).at("0000.png").image_id, 3u);  // Numbered after the last three.
+
+  NumberImagesByName(database);
+  const std::map<std::string, DatabaseImage> images = ReadDatabaseImages(database);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(images.at("000" + std::to_string(i) + ".png").image_id, i + 1u);
+  EXPECT_EQ(DescriptorsByName(database), before);
+  EXPECT_EQ(ReadFeatureCounts(database).at("0003.png"), static_cast<int>(before.at("0003.png").size() / 128));
+
+  NumberImagesByName(database);
+  EXPECT_EQ(DescriptorsByName(database), before);
+  MatchEveryPair(database);
+  try {
+    NumberImagesByName(database);
+    FAIL() << "a database with matches was numbered";
+  } catch (const BadInputError& error) {
+    EXPECT_NE(std::string(error.what()).find(database.string() + " by name: it holds matches"), std::string::npos)
+        << error.what();
+  }
+}
+
+// The matches of the six photos verified twice in two parts, one colmap thread each: the same
+// pairs with the same inliers both times, as many as colmap's own threads verify (whose random
+// streams are shared among pairs in whatever order the threads take them), and no part's files
+// left behind.
+TEST(Matching, VerificationInPartsIsTheSameOnEveryRun) {
+  const TempDir folder;
+  const fs::path database = folder.Path() / "database.db";
+  ExtractSixPhotos(folder.Path(), database);
+  NumberImagesByName(database);
+  const std::vector<std::array<uint32_t, 2>> pairs = MatchEveryPair(database);
+  ASSERT_EQ(pairs.size(), 15u);
+  const fs::path first = folder.Path() / "first.db", second = folder.Path() / "second.db",
+                 threads = folder.Path() / "threads.db", log = folder.Path() / "verification.log";
+  for (const fs::path& copy : {first, second, threads}) fs::copy_file(database, copy);
+  const Colmap colmap;
+  SilentProgress progress;
+  const std::vector<std::string> options = {"--SiftMatching.use_gpu", "0"};
+  for (const fs::path& copy : {first, second}) {
+    VerifyMatches(colmap, copy, pairs, 2, options, log, "verification", progress);
+  }
+  colmap.Run("exhaustive_matcher", {"--database_path", threads.string(), "--SiftMatching.use_gpu", "0"}, log,
+             "verification", 6, progress);
+
+  const PairCounts once = ReadPairs(first), again = ReadPairs(second), threaded = ReadPairs(threads);
+  EXPECT_EQ(once.inliers, again.inliers);
+  int inliers = 0, threaded_inliers = 0;
+  for (const auto& [pair, count] : once.inliers) inliers += count;
+  for (const auto& [pair, count] : threaded.inliers) threaded_inliers += count;
+  std::printf("[ measure ] verified pairs: in parts %zu, colmap's threads %zu; inliers %d / %d\n",
+              once.inliers.size(), threaded.inliers.size(), inliers, threaded_inliers);
+  EXPECT_GE(once.inliers.size(), 14u);
+  EXPECT_LE(once.inliers.size(), threaded.inliers.size() + 1);
+  EXPECT_GE(once.inliers.size() + 1, threaded.inliers.size());
+  EXPECT_NEAR(inliers, threaded_inliers, threaded_inliers * 0.03);
+  const std::string output = ReadFileBytes(log);
+  size_t runs = 0;
+  for (size_t at = 0; (at = output.find("exhaustive_matcher", at)) != std::string::npos; ++at) ++runs;
+  EXPECT_EQ(runs, 5u);  // Two parts twice, and colmap's threads once.
+  for (const auto& entry : fs::directory_iterator(folder.Path())) {
+    EXPECT_EQ(entry.path().string().find(".part"), std::string::npos) << entry.path();
+  }
+}
+
+// The same photos give the same cameras: structure from motion twice on the courtyard's first
+// 12 photos at fast quality, its model the same bytes both times (the images numbered by name,
+// the matches verified in fixed parts; colmap's mapper and adjustments repeat themselves given
+// those).
+TEST(Mapping, TheSamePhotosGiveTheSameCameras) {
+  const TempDir photos, first, second;
+  CopyPhotos(photos.Path(), [](int i) { return "photo_" + std::to_string(10 + i) + ".png"; }, 12);
+  ReconstructOptions options;
+  options.quality = Quality::kFast;
+  options.estimate_depth = false;
+  SilentProgress progress;
+  const ReconstructSummary summary = Reconstruct(photos.Path(), first.Path(), options, progress);
+  EXPECT_GE(summary.images_registered, 10);
+  Reconstruct(photos.Path(), second.Path(), options, progress);
+  for (const char* file : {"cameras.bin", "images.bin", "points3D.bin"}) {
+    const std::string model = ReadFileBytes(first.Path() / "sparse" / file);
+    EXPECT_FALSE(model.empty()) << file;
+    EXPECT_TRUE(model == ReadFileBytes(second.Path() / "sparse" / file)) << file << " differs";
+  }
 }
 
 // Past a hierarchical limit of 10 images the 24 photos are mapped in clusters of at most 10,
