@@ -508,8 +508,7 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
                        SparseFormat::kBinary);
     }
     // After the principal point's check: filtered first, entry-p10's point moved from 0.8% to
-    // 0.6% off-centre and the cameras with it (measured with the check by parts of the points,
-    // which needed the tail to see the point's scatter; not measured again since).
+    // 0.6% off-centre and the cameras with it (docs/cameras.md, "colmap's accuracy options").
     if (!sfm.known) notes.push_back(FilterAndAdjustRawModel(sfm));
     if (key_photos) {
       WriteSparseModel(RegisterOtherPhotos(sfm.colmap, paths,
