@@ -242,16 +242,22 @@ void MarkOtherPairsVerified(const std::filesystem::path& database,
              [&](sqlite3_stmt* row) { ids.push_back(static_cast<uint32_t>(sqlite3_column_int64(row, 0))); });
   Execute(database, connection.get(), "BEGIN");
   {
-    const Statement mark = Prepare(database, connection.get(),
-                                   "INSERT OR IGNORE INTO two_view_geometries (pair_id, rows, cols, data, config) "
-                                   "VALUES (?, 0, 2, NULL, 0)",
-                                   "write");
+    // colmap matches again a pair with a geometry and no matches: both are marked.
+    const Statement matched = Prepare(database, connection.get(),
+                                      "INSERT OR IGNORE INTO matches (pair_id, rows, cols, data) VALUES (?, 0, 2, NULL)",
+                                      "write");
+    const Statement verified = Prepare(database, connection.get(),
+                                       "INSERT OR IGNORE INTO two_view_geometries (pair_id, rows, cols, data, config) "
+                                       "VALUES (?, 0, 2, NULL, 0)",
+                                       "write");
     for (size_t i = 0; i < ids.size(); ++i) {
       for (size_t j = i + 1; j < ids.size(); ++j) {
         const int64_t pair_id = PairId(ids[i], ids[j]);
         if (kept.count(pair_id)) continue;
-        sqlite3_bind_int64(mark.get(), 1, pair_id);
-        StepOnce(database, connection.get(), mark.get(), "mark pairs verified");
+        for (sqlite3_stmt* mark : {matched.get(), verified.get()}) {
+          sqlite3_bind_int64(mark, 1, pair_id);
+          StepOnce(database, connection.get(), mark, "mark pairs verified");
+        }
       }
     }
   }

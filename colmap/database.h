@@ -82,9 +82,9 @@ std::vector<RawMatches> ReadRawMatches(const std::filesystem::path& database);
 // BadInputError naming the file if it cannot be written.
 void WriteRawMatches(const std::filesystem::path& database, const std::vector<RawMatches>& pairs);
 
-// Marks every pair of images of `database` except `pairs` (image ids) as verified with no
-// geometry, where it is not verified yet, in one transaction: colmap's matchers then verify
-// `pairs` only. Throws BadInputError naming the file if it cannot be written.
+// Marks every pair of images of `database` except `pairs` (image ids) as matched and verified
+// with nothing, where it is not yet, in one transaction: colmap's matchers then pass them by and
+// handle `pairs` only. Throws BadInputError naming the file if it cannot be written.
 void MarkOtherPairsVerified(const std::filesystem::path& database,
                             const std::vector<std::array<uint32_t, 2>>& pairs);
 

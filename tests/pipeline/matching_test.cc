@@ -260,8 +260,8 @@ TEST(Database, ImagesAreNumberedByName) {
 
 // The matches of the six photos verified twice in two parts, one colmap thread each: the same
 // pairs with the same inliers both times, as many as colmap's own threads verify (whose random
-// streams are shared among pairs in whatever order the threads take them), and no part's files
-// left behind.
+// streams are shared among pairs in whatever order the threads take them); a few pairs verified
+// alone; and no part's files left behind.
 TEST(Matching, VerificationInPartsIsTheSameOnEveryRun) {
   const TempDir folder;
   const fs::path database = folder.Path() / "database.db";
@@ -292,10 +292,25 @@ TEST(Matching, VerificationInPartsIsTheSameOnEveryRun) {
   EXPECT_LE(once.inliers.size(), threaded.inliers.size() + 1);
   EXPECT_GE(once.inliers.size() + 1, threaded.inliers.size());
   EXPECT_NEAR(inliers, threaded_inliers, threaded_inliers * 0.03);
+  // Five pairs verified alone: only they gain a geometry, and every pair keeps its matches.
+  const fs::path some = folder.Path() / "some.db";
+  fs::copy_file(database, some);
+  const std::vector<std::array<uint32_t, 2>> five(pairs.begin(), pairs.begin() + 5);
+  VerifyMatches(colmap, some, five, 2, options, log, "verification", progress);
+  const PairCounts some_pairs = ReadPairs(some);
+  EXPECT_EQ(some_pairs.matches, ReadPairs(database).matches);
+  EXPECT_GE(some_pairs.inliers.size(), 4u);
+  EXPECT_LE(some_pairs.inliers.size(), 5u);
+  const std::map<std::string, DatabaseImage> images = ReadDatabaseImages(database);
+  for (const auto& [names, inliers] : some_pairs.inliers) {
+    const std::array<uint32_t, 2> ids = {images.at(names.first).image_id, images.at(names.second).image_id};
+    EXPECT_NE(std::find(five.begin(), five.end(), ids), five.end()) << names.first << " " << names.second;
+  }
+
   const std::string output = ReadFileBytes(log);
   size_t runs = 0;
   for (size_t at = 0; (at = output.find("exhaustive_matcher", at)) != std::string::npos; ++at) ++runs;
-  EXPECT_EQ(runs, 5u);  // Two parts twice, and colmap's threads once.
+  EXPECT_EQ(runs, 7u);  // Two parts three times, and colmap's threads once.
   for (const auto& entry : fs::directory_iterator(folder.Path())) {
     EXPECT_EQ(entry.path().string().find(".part"), std::string::npos) << entry.path();
   }
