@@ -302,7 +302,7 @@ TEST(Matching, VerificationInPartsIsTheSameOnEveryRun) {
   EXPECT_GE(some_pairs.inliers.size(), 4u);
   EXPECT_LE(some_pairs.inliers.size(), 5u);
   const std::map<std::string, DatabaseImage> images = ReadDatabaseImages(database);
-  for (const auto& [names, inliers] : some_pairs.inliers) {
+  for (const auto& [names, verified] : some_pairs.inliers) {
     const std::array<uint32_t, 2> ids = {images.at(names.first).image_id, images.at(names.second).image_id};
     EXPECT_NE(std::find(five.begin(), five.end(), ids), five.end()) << names.first << " " << names.second;
   }
