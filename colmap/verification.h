@@ -20,7 +20,10 @@ namespace parallax {
 
 // Verifies the matches `database` holds for `pairs` (image ids) in `parts` parts at once (pair i
 // in part i mod `parts`), with colmap's matching `options` beside the database's path. Pairs
-// verified already stay as they are. colmap's output is appended to `log`, progress reported
+// verified already stay as they are. Each of `pairs` must have its matches stored: colmap would
+// match the others itself, and its matcher did not repeat itself on one thread (the same
+// keypoints gave other matches; its verifier thread seeds rand() while the matcher thread's
+// randomised k-d trees may be drawing from it). colmap's output is appended to `log`, progress reported
 // under `stage` as the parts finish. Throws ToolError if a colmap fails (its part's log kept
 // beside `log`), BadInputError if a database cannot be read or written.
 void VerifyMatches(const Colmap& colmap, const std::filesystem::path& database,
