@@ -89,33 +89,38 @@ std::string TextColumn(sqlite3_stmt* statement, int column) {
 
 }  // namespace
 
-void NumberImagesByName(const std::filesystem::path& database) {
+void NumberImagesByName(const std::filesystem::path& database, uint32_t after) {
   const Connection connection = Open(database, SQLITE_OPEN_READWRITE, "write");
+  const std::string above = std::to_string(after);
   int64_t matched = 0;
+  // A pair's second id is its larger.
+  const std::string pairs_above = "pair_id % " + std::to_string(kMaxImageId) + " > " + above;
   ForEachRow(database, connection.get(),
-             "SELECT (SELECT COUNT(*) FROM matches) + (SELECT COUNT(*) FROM two_view_geometries)",
+             ("SELECT (SELECT COUNT(*) FROM matches WHERE " + pairs_above +
+              ") + (SELECT COUNT(*) FROM two_view_geometries WHERE " + pairs_above + ")").c_str(),
              [&](sqlite3_stmt* row) { matched = sqlite3_column_int64(row, 0); });
   if (matched > 0) {
     throw BadInputError("cannot number the images of the COLMAP database " + database.string() +
-                        " by name: it holds matches already");
+                        " by name: they have matches already");
   }
   std::vector<int64_t> ids;  // In name order (SQLite compares text bytewise, as std::string does).
-  ForEachRow(database, connection.get(), "SELECT image_id FROM images ORDER BY name",
+  const std::string by_name = "SELECT image_id FROM images WHERE image_id > " + above + " ORDER BY name";
+  ForEachRow(database, connection.get(), by_name.c_str(),
              [&](sqlite3_stmt* row) { ids.push_back(sqlite3_column_int64(row, 0)); });
+  const auto number = [&](size_t i) { return int64_t{after} + static_cast<int64_t>(i) + 1; };
   bool numbered = true;
-  for (size_t i = 0; i < ids.size(); ++i) numbered = numbered && ids[i] == static_cast<int64_t>(i) + 1;
+  for (size_t i = 0; i < ids.size(); ++i) numbered = numbered && ids[i] == number(i);
   if (numbered) return;
   // Every id is first moved past the largest, so that no new number meets an old one.
   const int64_t offset = *std::max_element(ids.begin(), ids.end());
   Execute(database, connection.get(), "BEGIN");
   for (const char* table : {"images", "keypoints", "descriptors"}) {
-    Execute(database, connection.get(),
-            std::string("UPDATE ") + table + " SET image_id = image_id + " + std::to_string(offset));
-    const Statement renumber = Prepare(database, connection.get(),
-                                       (std::string("UPDATE ") + table + " SET image_id = ? WHERE image_id = ?").c_str(),
-                                       "write");
+    Execute(database, connection.get(), std::string("UPDATE ") + table + " SET image_id = image_id + " +
+                                            std::to_string(offset) + " WHERE image_id > " + above);
+    const std::string sql = std::string("UPDATE ") + table + " SET image_id = ? WHERE image_id = ?";
+    const Statement renumber = Prepare(database, connection.get(), sql.c_str(), "write");
     for (size_t i = 0; i < ids.size(); ++i) {
-      sqlite3_bind_int64(renumber.get(), 1, static_cast<int64_t>(i) + 1);
+      sqlite3_bind_int64(renumber.get(), 1, number(i));
       sqlite3_bind_int64(renumber.get(), 2, ids[i] + offset);
       StepOnce(database, connection.get(), renumber.get(), "number the images");
     }
@@ -243,9 +248,9 @@ void MarkOtherPairsVerified(const std::filesystem::path& database,
   Execute(database, connection.get(), "BEGIN");
   {
     // colmap matches again a pair with a geometry and no matches: both are marked.
-    const Statement matched = Prepare(database, connection.get(),
-                                      "INSERT OR IGNORE INTO matches (pair_id, rows, cols, data) VALUES (?, 0, 2, NULL)",
-                                      "write");
+    const Statement matched =
+        Prepare(database, connection.get(),
+                "INSERT OR IGNORE INTO matches (pair_id, rows, cols, data) VALUES (?, 0, 2, NULL)", "write");
     const Statement verified = Prepare(database, connection.get(),
                                        "INSERT OR IGNORE INTO two_view_geometries (pair_id, rows, cols, data, config) "
                                        "VALUES (?, 0, 2, NULL, 0)",

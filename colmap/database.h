@@ -17,13 +17,13 @@ struct DatabaseImage {
   uint32_t camera_id = 0;
 };
 
-// Numbers the images 1, 2, ... in name order, their keypoints and descriptors with them, in one
-// transaction. COLMAP's multi-threaded feature extractor numbers images in the order they
-// finish, and the numbers steer the order of matching and the mapper's choices between equals:
-// numbered by name, the same photos give the same database on every run. For a database
-// without matches yet (feature extraction's); throws BadInputError naming the file if it holds
-// matches or cannot be written.
-void NumberImagesByName(const std::filesystem::path& database);
+// Numbers the images numbered above `after` as after + 1, after + 2, ... in name order, their
+// keypoints and descriptors with them, in one transaction. COLMAP's multi-threaded feature
+// extractor numbers images in the order they finish, and the numbers steer the order of
+// matching and the mapper's choices between equals: numbered by name, the same photos give the
+// same database on every run. For images without matches yet (just extracted); throws
+// BadInputError naming the file if they have some or it cannot be written.
+void NumberImagesByName(const std::filesystem::path& database, uint32_t after = 0);
 
 // Image name -> ids. Throws BadInputError naming the file if it cannot be read.
 std::map<std::string, DatabaseImage> ReadDatabaseImages(const std::filesystem::path& database);

@@ -23,9 +23,9 @@ namespace parallax {
 // verified already stay as they are. Each of `pairs` must have its matches stored: colmap would
 // match the others itself, and its matcher did not repeat itself on one thread (the same
 // keypoints gave other matches; its verifier thread seeds rand() while the matcher thread's
-// randomised k-d trees may be drawing from it). colmap's output is appended to `log`, progress reported
-// under `stage` as the parts finish. Throws ToolError if a colmap fails (its part's log kept
-// beside `log`), BadInputError if a database cannot be read or written.
+// randomised k-d trees may be drawing from it). colmap's output is appended to `log`, progress
+// reported under `stage` as the parts finish. Throws ToolError if a colmap fails (its part's log
+// kept beside `log`), BadInputError if a database cannot be read or written.
 void VerifyMatches(const Colmap& colmap, const std::filesystem::path& database,
                    const std::vector<std::array<uint32_t, 2>>& pairs, int parts,
                    const std::vector<std::string>& options, const std::filesystem::path& log,

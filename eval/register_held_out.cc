@@ -1,10 +1,12 @@
 #include "eval/register_held_out.h"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <tbb/task_arena.h>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -13,6 +15,8 @@
 #include "core/workspace.h"
 #include "colmap/runner.h"
 #include "colmap/database.h"
+#include "colmap/verification.h"
+#include "sfm/pair_matching.h"
 #include "sfm/photo_conversion.h"
 #include "sfm/photo_set.h"
 #include "sfm/quality_settings.h"
@@ -82,7 +86,7 @@ void StagePhotos(const fs::path& images_dir, const std::map<std::string, std::st
 void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, const SparseModel& model,
                         const QualitySettings& features, const fs::path& images_dir,
                         const std::map<std::string, std::string>& staged, const std::string& list,
-                        const std::string& pairs, const fs::path& work_dir, Progress& progress) {
+                        const fs::path& work_dir, Progress& progress) {
   const fs::path registered = work_dir / "model";
   fs::remove_all(work_dir);
   fs::create_directories(registered);
@@ -91,7 +95,6 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
   const fs::path db = work_dir / "database.db";
   fs::copy_file(database, db);
   WriteFileAtomically(work_dir / "image_list.txt", list);
-  WriteFileAtomically(work_dir / "pairs.txt", pairs);
   const Colmap colmap;
   const fs::path log = work_dir / "colmap.log";
   const int count = static_cast<int>(staged.size());
@@ -115,12 +118,34 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
   } else {
     extract.insert(extract.end(), {"--ImageReader.single_camera", "1"});
   }
+  uint32_t last_id = 0;  // The held-out photos are numbered after it.
+  for (const auto& [name, image] : ReadDatabaseImages(db)) last_id = std::max(last_id, image.image_id);
   colmap.Run("feature_extractor", extract, log, "held-out features", count, progress);
-  colmap.Run("matches_importer",
-             {"--database_path", db.string(), "--match_list_path",
-              (work_dir / "pairs.txt").string(), "--match_type", "pairs",
-              "--SiftMatching.use_gpu", "0"},
-             log, "held-out matches", count, progress);
+  NumberImagesByName(db, last_id);
+  // Each held-out photo with every registered one, matched by brute force (colmap's matcher does
+  // not repeat itself) and verified in fixed parts: the same on every run.
+  const std::map<std::string, DatabaseImage> ids = ReadDatabaseImages(db);
+  const std::vector<DatabaseDescriptors> images = ReadDescriptors(db);
+  std::map<uint32_t, size_t> index;  // Image id -> its descriptors in `images`.
+  std::vector<SiftDescriptors> descriptors;
+  for (const DatabaseDescriptors& image : images) {
+    index[image.image_id] = descriptors.size();
+    descriptors.push_back({image.data.data(), image.rows});
+  }
+  std::vector<std::array<uint32_t, 2>> pairs;
+  std::vector<std::array<size_t, 2>> indices;
+  for (const auto& [name, staged_name] : staged) {
+    for (const SparseImage& image : model.Images()) {
+      pairs.push_back({ids.at(staged_name).image_id, ids.at(image.name).image_id});
+      indices.push_back({index.at(pairs.back()[0]), index.at(pairs.back()[1])});
+    }
+  }
+  const std::vector<std::vector<FeatureMatch>> matches = MatchSiftPairs(descriptors, indices);
+  std::vector<RawMatches> raw;
+  for (size_t p = 0; p < pairs.size(); ++p) raw.push_back({pairs[p][0], pairs[p][1], matches[p]});
+  WriteRawMatches(db, raw);
+  VerifyMatches(colmap, db, pairs, tbb::this_task_arena::max_concurrency(), {"--SiftMatching.use_gpu", "0"}, log,
+                "held-out matches", progress);
   colmap.Run("image_registrator",
              {"--database_path", db.string(), "--input_path", raw_model.string(),
               "--output_path", registered.string()},
@@ -148,9 +173,9 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   // Photos the database holds already (registered or not) would be taken for these.
   const std::map<std::string, DatabaseImage> in_database = ReadDatabaseImages(database);
   const std::map<std::string, std::string> staged = StagedNames(names, in_database);
-  std::string pairs, list;
+  std::string list;
   Hasher key_hasher;
-  key_hasher.Add("held-out-5")
+  key_hasher.Add("held-out-6")
       .Add(static_cast<uint64_t>(fs::file_size(database)))
       .Add(static_cast<uint64_t>(features.max_image_size))
       .Add(static_cast<uint64_t>(features.max_num_features));
@@ -159,7 +184,6 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
   for (const fs::path& file : model_files) key_hasher.Add(ReadFileBytes(file));
   for (const std::string& name : names) {
     const std::string& staged_name = staged.at(name);
-    for (const SparseImage& image : model.Images()) pairs += staged_name + " " + image.name + "\n";
     list += staged_name + "\n";
     key_hasher.Add(name).Add(ReadFileBytes(images_dir / name));
   }
@@ -170,7 +194,7 @@ HeldOutRegistration RegisterHeldOutPhotos(const fs::path& workspace, const fs::p
                      DetectSparseFormat(registered);
   if (!reuse) {
     try {
-      RegisterWithColmap(database, raw_model, model, features, images_dir, staged, list, pairs, work_dir,
+      RegisterWithColmap(database, raw_model, model, features, images_dir, staged, list, work_dir,
                          progress);
       WriteFileAtomically(key_file, key);
     } catch (const ToolError& e) {  // Only colmap's failure is a result; the rest is an error.

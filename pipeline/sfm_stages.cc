@@ -23,7 +23,7 @@
 #include "pipeline/key_photos.h"
 #include "pipeline/raw_model_workspace.h"
 #include "pipeline/undistort_workspace.h"
-#include "sfm/feature_matching.h"
+#include "sfm/pair_matching.h"
 #include "sfm/photo_conversion.h"
 
 namespace parallax {
@@ -103,27 +103,19 @@ struct Matching {
   // on both cores, and stores the matches for colmap to verify. Returns the pairs (image ids).
   std::vector<std::array<uint32_t, 2>> MatchEveryPair() const {
     const std::vector<DatabaseDescriptors> images = ReadDescriptors(database);
-    std::vector<RawMatches> pairs;
+    std::vector<SiftDescriptors> descriptors;
+    for (const DatabaseDescriptors& image : images) descriptors.push_back({image.data.data(), image.rows});
     std::vector<std::array<size_t, 2>> indices;
     for (size_t i = 0; i < images.size(); ++i) {
-      for (size_t j = i + 1; j < images.size(); ++j) {
-        pairs.push_back({images[i].image_id, images[j].image_id, {}});
-        indices.push_back({i, j});
-      }
+      for (size_t j = i + 1; j < images.size(); ++j) indices.push_back({i, j});
     }
-    auto descriptors = [&](size_t i) {
-      return SiftDescriptors{images[i].data.data(), images[i].rows};
-    };
-    const int total = static_cast<int>(pairs.size());
+    const auto total = static_cast<int64_t>(indices.size());
     sfm.progress.Update("matches", 0, total);
-    // Pairs in parallel, progress from this thread only (core/progress.h).
-    for (int start = 0; start < total; start += 16) {
-      const int end = std::min(total, start + 16);
-      tbb::parallel_for(start, end, [&](int p) {
-        const auto [i, j] = indices[static_cast<size_t>(p)];
-        pairs[static_cast<size_t>(p)].matches = MatchSiftFeatures(descriptors(i), descriptors(j));
-      });
-      sfm.progress.Update("matches", end, total);
+    const std::vector<std::vector<FeatureMatch>> matches = MatchSiftPairs(
+        descriptors, indices, [&](size_t done) { sfm.progress.Update("matches", static_cast<int64_t>(done), total); });
+    std::vector<RawMatches> pairs;
+    for (size_t p = 0; p < indices.size(); ++p) {
+      pairs.push_back({images[indices[p][0]].image_id, images[indices[p][1]].image_id, matches[p]});
     }
     WriteRawMatches(database, pairs);
     std::vector<std::array<uint32_t, 2>> ids;

@@ -230,8 +230,9 @@ TEST(Matching, BruteForceKeepsWhatColmapsMatcherKeeps) {
   EXPECT_GE(parallax_inliers, colmap_inliers * 97 / 100);
 }
 
-// Numbered by name, each of the six photos keeps its descriptors. Numbered already, a database stays as it is; once it holds matches, it is
-// refused.
+// Numbered by name, each of the six photos keeps its descriptors. A database numbered already
+// stays as it is; images with matches are refused, and photos added later are numbered after
+// the others.
 TEST(Database, ImagesAreNumberedByName) {
   const TempDir folder;
   const fs::path database = folder.Path() / "database.db";
@@ -251,11 +252,31 @@ TEST(Database, ImagesAreNumberedByName) {
   MatchEveryPair(database);
   try {
     NumberImagesByName(database);
-    FAIL() << "a database with matches was numbered";
+    FAIL() << "images with matches were numbered";
   } catch (const BadInputError& error) {
-    EXPECT_NE(std::string(error.what()).find(database.string() + " by name: it holds matches"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find(database.string() + " by name: they have matches"), std::string::npos)
         << error.what();
   }
+
+  // Photos added to the matched database (as evaluate registers held-out photos), read in the
+  // reverse of name order.
+  const fs::path list = folder.Path() / "more.txt";
+  for (const char* name : {"0006.png", "0007.png"}) {
+    fs::copy_file(kCourtyard / "images" / name, folder.Path() / "photos" / name);
+  }
+  WriteFileAtomically(list, "0007.png\n0006.png\n");
+  SilentProgress progress;
+  Colmap().Run("feature_extractor",
+               {"--database_path", database.string(), "--image_path", (folder.Path() / "photos").string(),
+                "--image_list_path", list.string(), "--SiftExtraction.use_gpu", "0",
+                "--SiftExtraction.max_image_size", "1024", "--SiftExtraction.max_num_features", "2048"},
+               folder.Path() / "colmap.log", "features", 2, progress);
+  const auto added = DescriptorsByName(database);
+  NumberImagesByName(database, 6);
+  EXPECT_EQ(ReadDatabaseImages(database).at("0006.png").image_id, 7u);
+  EXPECT_EQ(ReadDatabaseImages(database).at("0007.png").image_id, 8u);
+  EXPECT_EQ(DescriptorsByName(database), added);
+  EXPECT_THROW(NumberImagesByName(database, 5), BadInputError);
 }
 
 // The matches of the six photos verified twice in two parts, one colmap thread each: the same

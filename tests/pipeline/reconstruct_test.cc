@@ -147,6 +147,16 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   EXPECT_NE(RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, work, progress)
                 .note.find("reused"),
             std::string::npos);
+  // Registered again elsewhere, the photos come out at the same poses to the bit (their
+  // features numbered by name, their matches verified in fixed parts).
+  const HeldOutRegistration elsewhere =
+      RegisterHeldOutPhotos(workspace.Path(), scene.Novel().images, names, workspace.Path() / "again", progress);
+  ASSERT_EQ(elsewhere.registered.size(), held_out.registered.size()) << elsewhere.note;
+  for (const auto& [name, posed] : held_out.registered) {
+    const Rigid3d& again_pose = elsewhere.registered.at(name).cam_from_world;
+    EXPECT_TRUE(again_pose.rotation.coeffs() == posed.cam_from_world.rotation.coeffs()) << name;
+    EXPECT_TRUE(again_pose.translation == posed.cam_from_world.translation) << name;
+  }
   const HeldOutRegistration clash = RegisterHeldOutPhotos(
       workspace.Path(), scene.Training().images, {"0003.png"}, workspace.Path() / "clash", progress);
   // A held-out photo may share a training photo's name (here it is that very photo): it is
