@@ -125,25 +125,13 @@ void RegisterWithColmap(const fs::path& database, const fs::path& raw_model, con
   // Each held-out photo with every registered one, matched by brute force (colmap's matcher does
   // not repeat itself) and verified in fixed parts: the same on every run.
   const std::map<std::string, DatabaseImage> ids = ReadDatabaseImages(db);
-  const std::vector<DatabaseDescriptors> images = ReadDescriptors(db);
-  std::map<uint32_t, size_t> index;  // Image id -> its descriptors in `images`.
-  std::vector<SiftDescriptors> descriptors;
-  for (const DatabaseDescriptors& image : images) {
-    index[image.image_id] = descriptors.size();
-    descriptors.push_back({image.data.data(), image.rows});
-  }
   std::vector<std::array<uint32_t, 2>> pairs;
-  std::vector<std::array<size_t, 2>> indices;
   for (const auto& [name, staged_name] : staged) {
     for (const SparseImage& image : model.Images()) {
       pairs.push_back({ids.at(staged_name).image_id, ids.at(image.name).image_id});
-      indices.push_back({index.at(pairs.back()[0]), index.at(pairs.back()[1])});
     }
   }
-  const std::vector<std::vector<FeatureMatch>> matches = MatchSiftPairs(descriptors, indices);
-  std::vector<RawMatches> raw;
-  for (size_t p = 0; p < pairs.size(); ++p) raw.push_back({pairs[p][0], pairs[p][1], matches[p]});
-  WriteRawMatches(db, raw);
+  MatchAndStorePairs(db, pairs);
   VerifyMatches(colmap, db, pairs, tbb::this_task_arena::max_concurrency(), {"--SiftMatching.use_gpu", "0"}, log,
                 "held-out matches", progress);
   colmap.Run("image_registrator",

@@ -99,28 +99,22 @@ struct Matching {
     }
   }
 
-  // Matches every pair of photos in the database by brute force (sfm/feature_matching.h), pairs
-  // on both cores, and stores the matches for colmap to verify. Returns the pairs (image ids).
+  // Matches every pair of photos in the database by brute force (sfm/pair_matching.h), pairs on
+  // all cores, and stores the matches for colmap to verify. Returns the pairs (image ids, in
+  // their order).
   std::vector<std::array<uint32_t, 2>> MatchEveryPair() const {
-    const std::vector<DatabaseDescriptors> images = ReadDescriptors(database);
-    std::vector<SiftDescriptors> descriptors;
-    for (const DatabaseDescriptors& image : images) descriptors.push_back({image.data.data(), image.rows});
-    std::vector<std::array<size_t, 2>> indices;
-    for (size_t i = 0; i < images.size(); ++i) {
-      for (size_t j = i + 1; j < images.size(); ++j) indices.push_back({i, j});
+    std::vector<uint32_t> ids;
+    for (const auto& [name, image] : ReadDatabaseImages(database)) ids.push_back(image.image_id);
+    std::sort(ids.begin(), ids.end());
+    std::vector<std::array<uint32_t, 2>> pairs;
+    for (size_t i = 0; i < ids.size(); ++i) {
+      for (size_t j = i + 1; j < ids.size(); ++j) pairs.push_back({ids[i], ids[j]});
     }
-    const auto total = static_cast<int64_t>(indices.size());
+    const auto total = static_cast<int64_t>(pairs.size());
     sfm.progress.Update("matches", 0, total);
-    const std::vector<std::vector<FeatureMatch>> matches = MatchSiftPairs(
-        descriptors, indices, [&](size_t done) { sfm.progress.Update("matches", static_cast<int64_t>(done), total); });
-    std::vector<RawMatches> pairs;
-    for (size_t p = 0; p < indices.size(); ++p) {
-      pairs.push_back({images[indices[p][0]].image_id, images[indices[p][1]].image_id, matches[p]});
-    }
-    WriteRawMatches(database, pairs);
-    std::vector<std::array<uint32_t, 2>> ids;
-    for (const RawMatches& pair : pairs) ids.push_back({pair.first_image_id, pair.second_image_id});
-    return ids;
+    MatchAndStorePairs(database, pairs,
+                       [&](size_t done) { sfm.progress.Update("matches", static_cast<int64_t>(done), total); });
+    return pairs;
   }
 
   std::vector<std::string> Arguments() const {
