@@ -102,6 +102,12 @@ void AddSfmOptions(CLI::App& command, ReconstructArguments& arguments) {
                      "accurate poses)")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 1.0));
+  command.add_option("--track-rounds", arguments.options.max_retriangulations,
+                     "after the final adjustments, build the tracks afresh from the adjusted cameras, "
+                     "filter and adjust again, until the cameras settle or for at most this many rounds "
+                     "(0: keep the mapper's tracks; each round costs a bundle adjustment)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
   command.add_option("--camera-model", arguments.camera_model,
                      "COLMAP camera model for SfM (default SIMPLE_RADIAL: single focal length)");
   command.add_option("--intrinsics", arguments.intrinsics,

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <system_error>
 #include <unordered_set>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "core/error.h"
@@ -265,6 +266,16 @@ SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& 
     if (images.count(image.id)) selected.AddImage(ObservingOnly(image, points));
   }
   return selected;
+}
+
+SparseModel CamerasAndPoses(const SparseModel& model) {
+  SparseModel cameras;
+  for (const Camera& camera : model.Cameras()) cameras.AddCamera(camera);
+  for (SparseImage image : model.Images()) {
+    image.points2d.clear();
+    cameras.AddImage(std::move(image));
+  }
+  return cameras;
 }
 
 void WriteSparseModel(const SparseModel& model, const fs::path& dir, SparseFormat format) {

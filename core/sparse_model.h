@@ -104,6 +104,9 @@ SparseModel ReadSparseModelWithoutKeypoints(const std::filesystem::path& dir);
 // other points' observations are cleared, so that colmap reads the model as whole.
 SparseModel SelectImages(const SparseModel& model, const std::set<std::string>& names, bool keep);
 
+// `model`'s cameras and images, without points and keypoints.
+SparseModel CamerasAndPoses(const SparseModel& model);
+
 // Writes cameras, images and points3D in `format` into `dir` (created if missing). Each file is
 // written to a temporary name and renamed. Throws BadInputError if `dir` is not writable,
 // InternalError for a model the readers would refuse (a non-finite pose, say).

@@ -115,6 +115,19 @@ SparseModel AdjustModel(const Colmap& colmap, const Workspace& paths, const Spar
   return adjusted;
 }
 
+SparseModel RetriangulateRawModel(const Colmap& colmap, const Workspace& paths, const fs::path& image_dir,
+                                  Progress& progress) {
+  const fs::path input = paths.PartialModelScratch();
+  RemoveAll(input);
+  WriteSparseModel(CamerasAndPoses(ReadSparseModel(paths.RawModel())), input, SparseFormat::kBinary);
+  std::vector<std::string> arguments = MapperInputs(paths, image_dir);
+  Append(arguments, FixedIntrinsicsArguments());
+  Append(arguments, {"--Mapper.tri_ignore_two_view_tracks", "0"});
+  SparseModel model = RunOnModel(colmap, paths, input, "point_triangulator", arguments, "retriangulate", 0, progress);
+  RemoveAll(input);
+  return model;
+}
+
 SparseModel RegisterOtherPhotos(const Colmap& colmap, const Workspace& paths, const std::vector<std::string>& options,
                                 int num_images, Progress& progress) {
   std::vector<std::string> arguments = {"--database_path", paths.Database().string()};

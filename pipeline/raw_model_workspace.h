@@ -62,6 +62,12 @@ SparseModel AdjustRawModel(const Colmap& colmap, const Workspace& paths, const s
 SparseModel AdjustModel(const Colmap& colmap, const Workspace& paths, const SparseModel& model,
                         const std::vector<std::string>& options, const std::string& log_name, Progress& progress);
 
+// The raw model's points triangulated afresh from the database's verified matches (colmap
+// point_triangulator on its cameras and poses alone, which it holds as they are; tracks of two
+// photos kept). `image_dir`: the photos colmap reads. The raw model is left as it was.
+SparseModel RetriangulateRawModel(const Colmap& colmap, const Workspace& paths, const std::filesystem::path& image_dir,
+                                  Progress& progress);
+
 // The raw model with every other photo the database can place registered to its points (colmap
 // image_registrator with `options`: each photo's pose from its matches with the model's
 // points; no points are added and the model is not adjusted). The raw model is left as it was.

@@ -39,6 +39,7 @@ void ReconstructOptions::Check() const {
                 "in [0, 1)");
   RequireOption(min_principal_point_deviations > 0, "ReconstructOptions.min_principal_point_deviations",
                 min_principal_point_deviations, "> 0");
+  RequireOption(max_retriangulations >= 0, "ReconstructOptions.max_retriangulations", max_retriangulations, ">= 0");
   RequireOption(mvs_sources >= 0, "ReconstructOptions.mvs_sources", mvs_sources, ">= 0");
   RequireOption(mvs_scale == 0 || (mvs_scale >= 0.25 && mvs_scale <= 1), "ReconstructOptions.mvs_scale",
                 mvs_scale, "0 (as quality says) or [0.25, 1]");

@@ -92,6 +92,10 @@ struct ReconstructOptions {
   // the centre (docs/cameras.md, "The principal point by prediction").
   double min_principal_point_prediction_gain = 0.003;
   double min_principal_point_deviations = 3;
+  // After the final adjustments, the tracks are built afresh from the verified matches with
+  // the adjusted cameras, filtered and adjusted again, until the cameras settle or for at most
+  // this many rounds (0: the mapper's tracks are kept; docs/cameras.md, "Tracks built afresh").
+  int max_retriangulations = 10;
   // Photos held out of everything after structure from motion, as novel-view benchmarks hold
   // them out: registered with the others, then kept out of the depth stage, fusion, the mesh,
   // the color gains and the render sources, and written to Workspace::HeldOut for `evaluate`

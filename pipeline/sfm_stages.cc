@@ -5,9 +5,11 @@
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <numbers>
 #include <optional>
 #include <set>
 #include <string_view>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -19,6 +21,7 @@
 #include "core/error.h"
 #include "core/interrupt.h"
 #include "core/hash.h"
+#include "core/pose.h"
 #include "pipeline/camera_uncertainty.h"
 #include "pipeline/key_photos.h"
 #include "pipeline/raw_model_workspace.h"
@@ -155,17 +158,6 @@ double ExtractionScale(const SparseModel& model, Quality quality) {
 // prediction.
 constexpr double kMaxReprojectionErrorPx = 1;
 
-// `model`'s cameras and images, without points and keypoints.
-SparseModel CamerasAndPoses(const SparseModel& model) {
-  SparseModel cameras;
-  for (const Camera& camera : model.Cameras()) cameras.AddCamera(camera);
-  for (SparseImage image : model.Images()) {
-    image.points2d.clear();
-    cameras.AddImage(std::move(image));
-  }
-  return cameras;
-}
-
 // A final bundle adjustment that also frees the principal point, written over the raw model
 // only where CheckRefinedPrincipalPoint keeps it, after the same adjustment with the centre and
 // freed on each fold of the photos left out (PhotoFolds; a point that drifted past the limit is
@@ -212,18 +204,21 @@ size_t Observations(const SparseModel& model) {
   return observations;
 }
 
-// The raw model without its observations over kMaxReprojectionErrorPx, adjusted again
-// (intrinsics held where they are fixed); returns report.json's note.
-std::string FilterAndAdjustRawModel(const SfmContext& sfm) {
+// The raw model without its observations over kMaxReprojectionErrorPx, adjusted again (the
+// intrinsics held with `hold_intrinsics`, the principal point always; `adjustment`: more
+// bundle_adjuster options); returns report.json's note.
+std::string FilterAndAdjustRawModel(const SfmContext& sfm, bool hold_intrinsics,
+                                    const std::vector<std::string>& adjustment = {}) {
   const SparseModel raw = ReadSparseModel(sfm.workspace.RawModel());
   const double threshold_px = kMaxReprojectionErrorPx * ExtractionScale(raw, sfm.options.quality);
   const SparseModel filtered = RunOnRawModel(sfm.colmap, sfm.workspace, "point_filtering",
                                              {"--max_reproj_error", std::to_string(threshold_px)}, "filter", 0,
                                              sfm.progress);
   WriteSparseModel(filtered, sfm.workspace.RawModel(), SparseFormat::kBinary);
-  std::vector<std::string> options;
-  if (sfm.camera.fixed_intrinsics) {
-    options = {"--BundleAdjustment.refine_focal_length", "0", "--BundleAdjustment.refine_extra_params", "0"};
+  std::vector<std::string> options = adjustment;
+  if (hold_intrinsics) {
+    options.insert(options.end(),
+                   {"--BundleAdjustment.refine_focal_length", "0", "--BundleAdjustment.refine_extra_params", "0"});
   }
   WriteSparseModel(AdjustRawModel(sfm.colmap, sfm.workspace, options, "filter_adjust", sfm.progress),
                    sfm.workspace.RawModel(), SparseFormat::kBinary);
@@ -231,6 +226,66 @@ std::string FilterAndAdjustRawModel(const SfmContext& sfm) {
   std::snprintf(note, sizeof note,
                 "observations over %.2f px from their points dropped (%zu of %zu) and the model adjusted again",
                 threshold_px, Observations(raw) - Observations(filtered), Observations(raw));
+  return note;
+}
+
+// The mapper built its tracks while the cameras were still moving and kept the observations
+// that agreed with the cameras then; the tail filter keeps those that still agree. Where a
+// capture holds the poses loosely (castle-p19's loop of facades), those tracks hold the cameras
+// near where the mapper left them: tracks built afresh from the verified matches with the
+// adjusted cameras, filtered and adjusted again, move them on, round after round
+// (docs/cameras.md, "Tracks built afresh").
+// Rounds stop once no photo turns against another by more than this from one round to the next
+// (in pixels at the focal length, of the photos as SIFT saw them), or after
+// ReconstructOptions::max_retriangulations.
+constexpr double kSettledTurnPx = 0.5;
+
+// The largest change from `before` to `after` of the rotation between two photos (so whatever
+// frame either model is in), in pixels at the largest focal length of `after`'s cameras.
+double LargestRelativeTurnPx(const SparseModel& before, const SparseModel& after) {
+  double focal_px = 0;
+  for (const Camera& camera : after.Cameras()) focal_px = std::max({focal_px, camera.FocalX(), camera.FocalY()});
+  std::vector<std::pair<Eigen::Quaterniond, Eigen::Quaterniond>> rotations;  // before, after
+  for (const SparseImage& image : after.Images()) {
+    const SparseImage* earlier = before.FindImageByName(image.name);
+    if (earlier) rotations.emplace_back(earlier->cam_from_world.rotation, image.cam_from_world.rotation);
+  }
+  double largest_deg = 0;
+  for (size_t i = 0; i < rotations.size(); ++i) {
+    for (size_t j = i + 1; j < rotations.size(); ++j) {
+      const Eigen::Quaterniond was = rotations[i].first * rotations[j].first.conjugate();
+      const Eigen::Quaterniond is = rotations[i].second * rotations[j].second.conjugate();
+      largest_deg = std::max(largest_deg, RotationAngleDeg(was, is));
+    }
+  }
+  return largest_deg * std::numbers::pi / 180 * focal_px;
+}
+
+// Tracks built afresh from the raw model's cameras, then filtered and adjusted with the
+// intrinsics held, in rounds until the cameras settle; returns report.json's note.
+std::string RetriangulateUntilSettled(const SfmContext& sfm) {
+  const double settled_px =
+      kSettledTurnPx * ExtractionScale(ReadSparseModel(sfm.workspace.RawModel()), sfm.options.quality);
+  int rounds = 0;
+  double turn_px = 0;
+  do {
+    const SparseModel before = ReadSparseModel(sfm.workspace.RawModel());
+    WriteSparseModel(RetriangulateRawModel(sfm.colmap, sfm.workspace, sfm.photos_dir, sfm.progress),
+                     sfm.workspace.RawModel(), SparseFormat::kBinary);
+    // The intrinsics stay as the adjustments before left them: freed here, the focal length
+    // traded with the rotations of photos along an arc. Each adjustment stops where the cost
+    // changes by less than a millionth (in under half the time): the next round goes on from there.
+    FilterAndAdjustRawModel(sfm, true, {"--BundleAdjustment.function_tolerance", "1e-6"});
+    turn_px = LargestRelativeTurnPx(before, ReadSparseModel(sfm.workspace.RawModel()));
+    ++rounds;
+    sfm.progress.Update("mapper, tracks built afresh", rounds, sfm.options.max_retriangulations);
+  } while (turn_px > settled_px && rounds < sfm.options.max_retriangulations);
+  char note[240];
+  std::snprintf(note, sizeof note,
+                "tracks built afresh from the adjusted cameras, filtered and adjusted again: %d round%s, the "
+                "last turning two photos against each other by %.2f px at most%s",
+                rounds, rounds == 1 ? "" : "s", turn_px,
+                turn_px > settled_px ? " (not settled: the rounds' limit)" : "");
   return note;
 }
 
@@ -448,9 +503,11 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
   }
   if (key_photos) hasher.Add("key photos").Add(ImageListText(plan.key_photos));
   if (!sfm.known) hasher.Add("filtered and adjusted-1");
+  const bool retriangulates = !sfm.known && !hierarchical && !key_photos && sfm.options.max_retriangulations > 0;
+  if (retriangulates) hasher.Add("tracks built afresh-1").Add(static_cast<uint64_t>(sfm.options.max_retriangulations));
   stage.key = hasher.Hex();
   stage.outputs = {paths.RawModel()};
-  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, key_photos,
+  stage.run = [&sfm, &notes, paths, num_images, refine_principal_point, hierarchical, key_photos, retriangulates,
                keys = plan.key_photos, name = stage.name] {
     const fs::path models = paths.Models().string() + ".tmp";
     const TemporaryOutput temporary(models);
@@ -495,7 +552,8 @@ Stage MapperStage(const SfmContext& sfm, const MapperPlan& plan, const std::stri
     }
     // After the principal point's check: filtered first, entry-p10's point moved from 0.8% to
     // 0.6% off-centre and the cameras with it (docs/cameras.md, "colmap's accuracy options").
-    if (!sfm.known) notes.push_back(FilterAndAdjustRawModel(sfm));
+    if (!sfm.known) notes.push_back(FilterAndAdjustRawModel(sfm, sfm.camera.fixed_intrinsics));
+    if (retriangulates) notes.push_back(RetriangulateUntilSettled(sfm));
     if (key_photos) {
       WriteSparseModel(RegisterOtherPhotos(sfm.colmap, paths,
                                            sfm.camera.fixed_intrinsics ? FixedIntrinsicsArguments()
