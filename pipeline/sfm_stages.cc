@@ -264,19 +264,20 @@ double LargestRelativeTurnPx(const SparseModel& before, const SparseModel& after
 // Tracks built afresh from the raw model's cameras, then filtered and adjusted with the
 // intrinsics held, in rounds until the cameras settle; returns report.json's note.
 std::string RetriangulateUntilSettled(const SfmContext& sfm) {
-  const double settled_px =
-      kSettledTurnPx * ExtractionScale(ReadSparseModel(sfm.workspace.RawModel()), sfm.options.quality);
+  SparseModel before = ReadSparseModel(sfm.workspace.RawModel());
+  const double settled_px = kSettledTurnPx * ExtractionScale(before, sfm.options.quality);
   int rounds = 0;
   double turn_px = 0;
   do {
-    const SparseModel before = ReadSparseModel(sfm.workspace.RawModel());
     WriteSparseModel(RetriangulateRawModel(sfm.colmap, sfm.workspace, sfm.photos_dir, sfm.progress),
                      sfm.workspace.RawModel(), SparseFormat::kBinary);
     // The intrinsics stay as the adjustments before left them: freed here, the focal length
     // traded with the rotations of photos along an arc. Each adjustment stops where the cost
     // changes by less than a millionth (in under half the time): the next round goes on from there.
     FilterAndAdjustRawModel(sfm, true, {"--BundleAdjustment.function_tolerance", "1e-6"});
-    turn_px = LargestRelativeTurnPx(before, ReadSparseModel(sfm.workspace.RawModel()));
+    SparseModel after = ReadSparseModel(sfm.workspace.RawModel());
+    turn_px = LargestRelativeTurnPx(before, after);
+    before = std::move(after);
     ++rounds;
     sfm.progress.Update("mapper, tracks built afresh", rounds, sfm.options.max_retriangulations);
   } while (turn_px > settled_px && rounds < sfm.options.max_retriangulations);
