@@ -89,11 +89,28 @@ void PrintBudgets(const NovelEvaluation& result) {
   row("mean", result.budget_mean);
 }
 
+// How far each registered photo landed from its true pose (through the training cameras'
+// alignment), beside the misalignment its render shows.
+void PrintRegisteredPoseErrors(const std::vector<ImagePoseError>& errors) {
+  if (errors.empty()) return;
+  double rotation_mean = 0;
+  double center_mean = 0;
+  std::printf("%-16s %14s %17s\n", "registered pose", "rotation (deg)", "centre (% extent)");
+  for (const ImagePoseError& error : errors) {
+    std::printf("%-16s %14.4f %17.4f\n", error.name.c_str(), error.rotation_error_deg, 100 * error.center_error_rel);
+    rotation_mean += error.rotation_error_deg / static_cast<double>(errors.size());
+    center_mean += error.center_error_rel / static_cast<double>(errors.size());
+  }
+  std::printf("registered poses against the truth: rotation error mean %.4f deg, centre error mean %.4f%%\n",
+              rotation_mean, 100 * center_mean);
+}
+
 void PrintNovel(const NovelViewsEvaluation& novel) {
   const NovelEvaluation& result = novel.result;
   if (novel.registration_tried) {
     std::printf("novel camera poses: %s\n", novel.registration_note.c_str());
   }
+  PrintRegisteredPoseErrors(novel.registered_pose_errors);
   if (!novel.gt_sources) std::printf("novel views: depth holes %s\n", novel.depth_holes_note.c_str());
   std::printf("%-16s %9s %7s %14s %16s %7s\n", "novel view", "PSNR (dB)", "SSIM", "sampled (dB)",
               "exposure (dB)", "holes");

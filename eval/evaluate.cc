@@ -8,6 +8,13 @@
 
 namespace parallax {
 
+ImagePoseError PoseError(const std::string& name, const Rigid3d& estimate, const Rigid3d& truth,
+                         const Similarity3d& alignment, double extent) {
+  const Rigid3d aligned = alignment.TransformPose(estimate);
+  return {name, RotationAngleDeg(aligned.rotation, truth.rotation),
+          (CameraCenter(aligned) - CameraCenter(truth)).norm() / extent};
+}
+
 PoseEvaluation EvaluatePoses(const SparseModel& estimate, const SparseModel& ground_truth) {
   PoseEvaluation evaluation;
   evaluation.total = static_cast<int>(ground_truth.Images().size());
@@ -37,12 +44,8 @@ PoseEvaluation EvaluatePoses(const SparseModel& estimate, const SparseModel& gro
   }
   std::vector<double> rotation_errors;
   for (size_t i = 0; i < names.size(); ++i) {
-    const Rigid3d aligned = evaluation.alignment.target_from_source.TransformPose(estimated_cams[i]);
-    ImagePoseError error;
-    error.name = names[i];
-    error.rotation_error_deg = RotationAngleDeg(aligned.rotation, true_cams[i].rotation);
-    error.center_error_rel =
-        (CameraCenter(aligned) - CameraCenter(true_cams[i])).norm() / evaluation.extent;
+    const ImagePoseError error = PoseError(names[i], estimated_cams[i], true_cams[i],
+                                           evaluation.alignment.target_from_source, evaluation.extent);
     evaluation.rotation_error_mean_deg += error.rotation_error_deg / static_cast<double>(names.size());
     evaluation.center_error_rel_mean += error.center_error_rel / static_cast<double>(names.size());
     evaluation.rotation_error_max_deg = std::max(evaluation.rotation_error_max_deg, error.rotation_error_deg);

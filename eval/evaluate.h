@@ -18,6 +18,11 @@ struct ImagePoseError {
   double center_error_rel = 0;  // Relative to the ground-truth extent.
 };
 
+// `estimate` (a camera's pose in the reconstruction) taken into the truth's frame by `alignment`
+// and compared with `truth`; the centre error relative to `extent`.
+ImagePoseError PoseError(const std::string& name, const Rigid3d& estimate, const Rigid3d& truth,
+                         const Similarity3d& alignment, double extent);
+
 struct PoseEvaluation {
   int registered = 0;  // Ground-truth images present in the reconstruction.
   int total = 0;       // Ground-truth images.

@@ -103,10 +103,11 @@ void RenderAndCompare(const Workspace& workspace, ViewSetPaths sources, const st
 
 // The scene's novel cameras rendered from the workspace (cameras mapped into its frame) or,
 // with gt_sources, from the scene's own training views and depth; compared with the novel
-// images.
+// images. Registered poses are measured against the truth through the training cameras'
+// alignment (`poses`).
 NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder& scene,
-                                   const EvaluateOptions& options,
-                                   const Similarity3d& truth_from_estimate, Progress& progress,
+                                   const EvaluateOptions& options, const Similarity3d& truth_from_estimate,
+                                   const PoseEvaluation& poses, Progress& progress,
                                    std::vector<NamedCamera>* targets_out, std::vector<std::string>* names_out) {
   NovelViewsEvaluation evaluation;
   evaluation.gt_sources = options.gt_sources;
@@ -130,6 +131,9 @@ NovelViewsEvaluation EvaluateNovel(const Workspace& workspace, const SceneFolder
       if (found == registration.registered.end()) continue;
       targets[i].camera = found->second;
       ++evaluation.poses_registered;
+      evaluation.registered_pose_errors.push_back(PoseError(
+          names[i], found->second.cam_from_world, novel.Images()[i].cam_from_world,
+          poses.alignment.target_from_source, poses.extent));
     }
     evaluation.registration_tried = true;
     evaluation.registration_note = registration.note;
@@ -192,7 +196,8 @@ WorkspaceEvaluation EvaluateWorkspace(const Workspace& workspace, const SceneFol
   if (fs::is_directory(scene.Novel().sparse) && (options.gt_sources || has_depth)) {
     std::vector<NamedCamera> targets;
     std::vector<std::string> names;
-    evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate, progress, &targets, &names);
+    evaluation.novel = EvaluateNovel(workspace, scene, options, truth_from_estimate,
+                                     evaluation.poses, progress, &targets, &names);
     // The ground-truth sources' cameras are in the scene's frame, not the mesh's.
     if (!options.gt_sources) ScoreMeshAtNovelCameras(workspace, targets, names, scene.Novel().images, options, evaluation);
   }
@@ -278,6 +283,14 @@ void to_json(nlohmann::json& json, const WorkspaceEvaluation& evaluation) {
                      {"poses", novel.poses},
                      {"poses_registered", novel.poses_registered},
                      {"budget_mean", BudgetJson(result.budget_mean)}};
+    if (!novel.registered_pose_errors.empty()) {
+      nlohmann::json& errors = json["novel"]["registered_pose_errors"] = nlohmann::json::array();
+      for (const ImagePoseError& error : novel.registered_pose_errors) {
+        errors.push_back({{"name", error.name},
+                          {"rotation_error_deg", error.rotation_error_deg},
+                          {"center_error_rel", error.center_error_rel}});
+      }
+    }
     nlohmann::json& per_view = json["novel"]["per_view"] = nlohmann::json::array();
     for (const NovelViewScore& view : result.per_view) {
       per_view.push_back({{"name", view.name},

@@ -63,6 +63,9 @@ struct NovelViewsEvaluation {
   int poses_registered = 0;
   bool registration_tried = false;
   std::string registration_note;  // What the registration did, when tried, and what it did not.
+  // The registered poses against the scene's novel ground truth, taken through the training
+  // cameras' alignment: how far a photo added to the finished model lands from its true pose.
+  std::vector<ImagePoseError> registered_pose_errors;
   std::string depth_holes_note;   // Workspace sources: where their depth holes came from.
   std::filesystem::path comparison_dir;
 };

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <optional>
 
@@ -124,12 +125,14 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   // Each pose comes with the camera it was solved with: the workspace's, unmoved.
   const Camera shared = ReadSparseModel(Workspace(workspace.Path()).RawModel()).Cameras().front();
   for (const auto& [name, posed] : held_out.registered) EXPECT_EQ(posed.camera.params, shared.params) << name;
+  std::map<std::string, double> registered_angles_deg;
   for (const SparseImage& image : novel.Images()) {
     if (!held_out.registered.contains(image.name)) continue;
     const Rigid3d pose =
         evaluation.alignment.target_from_source.TransformPose(held_out.registered.at(image.name).cam_from_world);
     const double angle_deg =
         pose.rotation.angularDistance(image.cam_from_world.rotation) * 180 / std::numbers::pi;
+    registered_angles_deg[image.name] = angle_deg;
     // As accurate as the training cameras, within a factor of 2.
     EXPECT_LT(angle_deg, 2 * evaluation.rotation_error_max_deg) << image.name;
     EXPECT_LT((CameraCenter(pose) - CameraCenter(image.cam_from_world)).norm(),
@@ -196,6 +199,13 @@ TEST(Reconstruct, SmallSceneRegistersEveryPhotoWithAccurateCamerasAndResumes) {
   EXPECT_EQ(real.novel->result.views, 4);
   EXPECT_GT(real.novel->result.psnr_mean, 20);
   EXPECT_GE(real.novel->result.psnr_exposure_matched_mean, real.novel->result.psnr_mean - 0.5);
+  // Each registered photo's pose error against the truth is reported, as measured above.
+  ASSERT_EQ(real.novel->registered_pose_errors.size(), registered_angles_deg.size());
+  for (const ImagePoseError& error : real.novel->registered_pose_errors) {
+    ASSERT_TRUE(registered_angles_deg.contains(error.name)) << error.name;
+    EXPECT_NEAR(error.rotation_error_deg, registered_angles_deg.at(error.name), 1e-6) << error.name;
+    EXPECT_LT(error.center_error_rel, 2 * evaluation.center_error_rel_max) << error.name;
+  }
 }
 
 TEST(Reconstruct, KnownCamerasAreKeptAndOnlyTriangulated) {
