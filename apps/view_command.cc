@@ -38,6 +38,7 @@ struct ViewArguments {
   FrameSettings settings;
   bool no_cameras = false;
   bool no_grid = false;
+  std::optional<bool> glare;  // Unset: with auto exposure.
   int timed_frames = 0;  // Extra frames drawn after the screenshot to time the renderer.
   bool shadow_iou = false;  // Compare the screenshot's shadows with Embree ray tracing.
 };
@@ -57,6 +58,7 @@ FrameSettings Settings(const ViewArguments& a, const ViewerScene& scene) {
   }
   settings.show_cameras = !a.no_cameras;
   settings.show_grid = !a.no_grid;
+  settings.glare = a.glare.value_or(settings.auto_exposure);
   if (!a.point_light.empty()) {
     const std::vector<double> p = ParseNumbers(a.point_light, 3, "--point-light");
     settings.light.type = LightKind::kPoint;
@@ -162,6 +164,9 @@ void AddLookOptions(CLI::App& command, ViewArguments& a) {
   command.add_flag("--auto-exposure", a.settings.auto_exposure,
                    "expose each frame for its log-average luminance (mid grey 0.18), tone-mapped; in the window "
                    "the eye adapts over half a second");
+  command.add_flag("--glare,!--no-glare", a.glare,
+                   "spread light over the display's white into a halo before tone mapping, keeping its energy "
+                   "(default: on with --auto-exposure)");
   command.add_option("--light-intensity", a.settings.light.intensity,
                      "the light's irradiance, linear (default 1; a point light's at the scene's centre)")
       ->check(CLI::Range(0.0, 1e6));

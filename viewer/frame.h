@@ -66,6 +66,9 @@ struct FrameSettings {
   bool auto_exposure = false;
   // Time constant of the eye's adaptation to a new brightness (seconds); 0 adapts at once.
   float adaptation_seconds = 0;
+  // Light over the display's white spread into a halo before tone mapping (viewer/glare.h),
+  // through the float frame.
+  bool glare = false;
   int shadow_map_size = 2048;     // Shadow map side in texels, 64..8192.
   int pcf_radius = 1;             // PCF kernel radius in texels (kernel 2r+1 square), 0..4.
   int projective_views = 3;       // Source photos blended in projective mode, 1..kMaxProjectors.
@@ -78,6 +81,8 @@ struct FrameSettings {
   bool reverse_z = true;          // Use reverse-Z where glClipControl exists.
   Eigen::Vector3f background{0.32f, 0.36f, 0.42f};  // Linear RGB.
   void Check() const;             // Throws UsageError naming the field.
+  // Whether the frame is drawn in linear light into the float frame, then tone-mapped.
+  bool DrawnInFloat() const { return tone_map != ToneMap::kClamp || auto_exposure || glare; }
 };
 
 // Where the frame is seen from. The camera is used as a pinhole (distortion ignored).
@@ -92,6 +97,9 @@ struct FrameResult {
   // Per pixel: light visibility in [0, 1] (1 lit; shadow map/PCF/planar), n.l (the normal
   // turned towards the eye), eye z-depth, coverage (1 where a surface was drawn).
   Image aux;
+  // The float frame in linear light before exposure (after the glare where there is one), RGB
+  // top row first; empty where the frame was drawn straight into the 8-bit frame.
+  Image linear;
 };
 
 }  // namespace parallax

@@ -5,6 +5,7 @@
 #include <span>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "viewer/blob_shadow_pass.h"
 #include "viewer/depth_pass.h"
@@ -32,6 +33,23 @@ bool HasExtension(std::string_view name) {
     }
   }
   return false;
+}
+
+// The first attachment of `framebuffer`, a float frame of `width` x `height`: RGB, top row first.
+Image ReadLinearFrame(GLuint framebuffer, int width, int height) {
+  std::vector<float> texels(static_cast<size_t>(width) * height * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, texels.data());
+  CheckGlError("SceneRenderer::Render read back of the float frame");
+  Image linear(width, height, 3);
+  for (int y = 0; y < height; ++y) {
+    const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < 3; ++c) linear.At(x, y, c) = texels[(row + x) * 4 + c];
+    }
+  }
+  return linear;
 }
 
 }  // namespace
@@ -199,7 +217,7 @@ FrameContext SceneRenderer::Impl::MakeFrame(const ViewCamera& view, const FrameS
       .ground_band = GroundBand(scene),
       .range = Range(),
       .reverse_z = reverse_z,
-      .hdr = settings.tone_map != ToneMap::kClamp || settings.auto_exposure,
+      .hdr = settings.DrawnInFloat(),
   };
 }
 
@@ -335,7 +353,7 @@ FrameResult SceneRenderer::Render(const ViewCamera& view, const FrameSettings& s
   glReadBuffer(GL_COLOR_ATTACHMENT1);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aux.data());
   CheckGlError("SceneRenderer::Render read back");
-  FrameResult result{Image(width, height, 3), Image(width, height, 4)};
+  FrameResult result{Image(width, height, 3), Image(width, height, 4), Image()};
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
     for (int x = 0; x < width; ++x) {
@@ -343,6 +361,7 @@ FrameResult SceneRenderer::Render(const ViewCamera& view, const FrameSettings& s
       for (int c = 0; c < 4; ++c) result.aux.At(x, y, c) = aux[(row + x) * 4 + c];
     }
   }
+  if (settings.DrawnInFloat()) result.linear = ReadLinearFrame(impl_->tone_mapper.LinearFramebuffer(), width, height);
   return result;
 }
 

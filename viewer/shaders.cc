@@ -310,6 +310,40 @@ void main() {
 }
 )";
 
+const char* const kGlareExcess = R"(
+uniform float u_exposure;
+uniform float u_white;  // The exposed value the display shows as white.
+vec3 Excess(vec3 c) { return max(c - vec3(u_white / u_exposure), vec3(0.0)); }
+)";
+
+const char* const kGlareFirstLevelFragment = R"(
+uniform sampler2D u_hdr;
+layout(location = 0) out vec4 o_excess;
+void main() {
+  ivec2 size = textureSize(u_hdr, 0);
+  vec3 sum = vec3(0.0);
+  for (int i = 0; i < 4; ++i) {
+    ivec2 p = 2 * ivec2(gl_FragCoord.xy) + ivec2(i & 1, i >> 1);
+    if (all(lessThan(p, size))) sum += Excess(max(texelFetch(u_hdr, p, 0).rgb, vec3(0.0)));
+  }
+  o_excess = vec4(0.25 * sum, 1.0);
+}
+)";
+
+const char* const kGlareCompositeFragment = R"(
+uniform sampler2D u_hdr;
+uniform sampler2D u_levels[6];
+uniform vec2 u_extent;  // The pixels the pyramid covers: the frame padded to a multiple of 64.
+layout(location = 0) out vec4 o_color;
+void main() {
+  vec3 c = max(texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb, vec3(0.0));
+  vec2 uv = gl_FragCoord.xy / u_extent;
+  vec3 halo = texture(u_levels[0], uv).rgb + texture(u_levels[1], uv).rgb + texture(u_levels[2], uv).rgb +
+              texture(u_levels[3], uv).rgb + texture(u_levels[4], uv).rgb + texture(u_levels[5], uv).rgb;
+  o_color = vec4(c - Excess(c) + halo / 6.0, 1.0);
+}
+)";
+
 const char* const kLineVertex = R"(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 3) in vec3 a_color;  // Linear RGB.

@@ -31,6 +31,14 @@ extern const char* const kBlobFragment;
 extern const char* const kToneMapVertex;
 extern const char* const kToneMapFragment;
 
+// Glare (viewer/glare.h). Neither fragment shader has a #version line: prefix each with
+// "#version 330 core" and kGlareExcess, the light a pixel holds over the display's white.
+extern const char* const kGlareExcess;
+// The excess of 2x2 pixels of the float frame averaged: the first level of the pyramid.
+extern const char* const kGlareFirstLevelFragment;
+// The float frame less its excess, plus the pyramid's levels upsampled and averaged.
+extern const char* const kGlareCompositeFragment;
+
 // Colored lines: camera frusta and the ground grid.
 extern const char* const kLineVertex;
 extern const char* const kLineFragment;

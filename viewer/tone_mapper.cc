@@ -8,6 +8,27 @@
 #include "viewer/shaders.h"
 
 namespace parallax {
+namespace {
+
+// The operator a frame is mapped with: auto exposure alone, on an 8-bit frame that would clip,
+// maps as Reinhard does.
+ToneMap Operator(const FrameSettings& settings) {
+  return settings.tone_map == ToneMap::kClamp && settings.auto_exposure ? ToneMap::kReinhard : settings.tone_map;
+}
+
+// The exposed value `op` shows as white: what the glare spreads is over it.
+float DisplayWhite(ToneMap op, float reinhard_white) {
+  switch (op) {
+    case ToneMap::kReinhard: return reinhard_white;
+    // Where the ACES fit (2.51c^2 + 0.03c) / (2.43c^2 + 0.59c + 0.14) reaches 1:
+    // 0.08c^2 - 0.56c - 0.14 = 0.
+    case ToneMap::kAces: return static_cast<float>((0.56 + std::sqrt(0.56 * 0.56 + 4 * 0.08 * 0.14)) / 0.16);
+    case ToneMap::kClamp: break;
+  }
+  return 1;
+}
+
+}  // namespace
 
 ToneMapper::ToneMapper(FrameClock clock)
     : program_("tone map", shaders::kToneMapVertex, shaders::kToneMapFragment),
@@ -61,19 +82,26 @@ double ToneMapper::Exposure(const FrameSettings& settings, const gpu::EyeTarget&
 
 void ToneMapper::Map(const FrameSettings& settings, const gpu::EyeTarget& eye, bool with_aux) {
   const double exposure = Exposure(settings, eye);
+  const ToneMap op = Operator(settings);
+  GLuint linear = eye.hdr.Get();
+  linear_framebuffer_ = eye.hdr_framebuffer.Get();
+  if (settings.glare) {
+    if (!glare_) glare_.emplace();
+    glare_->Apply(eye, static_cast<float>(exposure), DisplayWhite(op, settings.white));
+    linear = glare_->Result().Get();
+    linear_framebuffer_ = glare_->ResultFramebuffer().Get();
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
   const GLenum color_only = GL_COLOR_ATTACHMENT0;
   glDrawBuffers(1, &color_only);
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_STENCIL_TEST);
   glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
-  glBindTexture(GL_TEXTURE_2D, eye.hdr.Get());
+  glBindTexture(GL_TEXTURE_2D, linear);
   glActiveTexture(GL_TEXTURE0);
   program_.Use();
   program_.Set("u_hdr", gpu::kScratchUnit);
   program_.Set("u_exposure", static_cast<float>(exposure));
-  // Auto exposure alone, on an 8-bit frame that would clip, maps as Reinhard does.
-  const ToneMap op = settings.tone_map == ToneMap::kClamp ? ToneMap::kReinhard : settings.tone_map;
   program_.Set("u_operator", op == ToneMap::kReinhard ? 1 : op == ToneMap::kAces ? 2 : 0);
   program_.Set("u_white", settings.white);
   glBindVertexArray(empty_vao_.Get());

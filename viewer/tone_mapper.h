@@ -3,11 +3,13 @@
 // (FrameSettings::tone_map other than kClamp, or auto_exposure) is exposed and mapped into the
 // 8-bit sRGB frame by one screen-covering triangle. With auto exposure, a shrunk copy of the
 // float frame is read back for its log-average luminance, and the eye adapts towards it over
-// the settings' time constant. Needs a current GL context.
+// the settings' time constant. With FrameSettings::glare, the light over the display's white is
+// spread into a halo first (viewer/glare.h). Needs a current GL context.
 #include <optional>
 
 #include "viewer/frame.h"
 #include "viewer/gl.h"
+#include "viewer/glare.h"
 #include "viewer/gpu_resources.h"
 
 namespace parallax {
@@ -22,6 +24,10 @@ class ToneMapper {
   // the color, and the auxiliary target when `with_aux`.
   void Map(const FrameSettings& settings, const gpu::EyeTarget& eye, bool with_aux);
 
+  // The framebuffer whose first attachment holds the last frame mapped in linear light, before
+  // exposure (after the glare where there was one): eye.hdr's or the glare's.
+  GLuint LinearFramebuffer() const { return linear_framebuffer_; }
+
  private:
   // The linear scale of the frame: 2^exposure_stops, with auto exposure times mid grey over the
   // adapted luminance.
@@ -30,6 +36,8 @@ class ToneMapper {
   double LogAverageLuminance(const gpu::EyeTarget& eye);
 
   GlProgram program_;
+  std::optional<Glare> glare_;  // Made at the first frame that asks for it.
+  GLuint linear_framebuffer_ = 0;
   GlVertexArray empty_vao_;  // The triangle has no vertex buffer.
   GlTexture meter_;          // The float frame shrunk, to read its brightness back.
   GlFramebuffer meter_framebuffer_;

@@ -99,6 +99,7 @@ void OnKey(GLFWwindow* window, int key, int, int action, int) {
     case GLFW_KEY_P: settings.points_with_mesh = settings.show_points = !settings.show_points; break;
     case GLFW_KEY_M: settings.show_mesh = !settings.show_mesh; break;
     case GLFW_KEY_G: settings.show_grid = !settings.show_grid; break;
+    case GLFW_KEY_H: settings.glare = !settings.glare; break;
     case GLFW_KEY_L:
       settings.light.type = settings.light.type == LightKind::kPoint ? LightKind::kDirectional : LightKind::kPoint;
       break;
@@ -170,10 +171,11 @@ std::string WindowTitle(const WindowState& s, double frame_ms) {
     std::snprintf(view, sizeof(view), "view az %.0f el %.0f dist %.3g", s.azimuth_deg, s.elevation_deg, s.distance);
   }
   char title[320];
-  std::snprintf(title, sizeof(title), "parallax view | shadows %s | texture %s | %s | %s light az %.0f el %.0f | %.1f ms",
+  std::snprintf(title, sizeof(title),
+                "parallax view | shadows %s | texture %s | %s | %s light az %.0f el %.0f%s | %.1f ms",
                 ShadowName(s.settings.shadows), TextureName(s.settings.texture), view,
                 s.settings.light.type == LightKind::kPoint ? "point" : "directional", s.light_azimuth_deg,
-                s.light_elevation_deg, frame_ms);
+                s.light_elevation_deg, s.settings.glare ? " | glare" : "", frame_ms);
   return title;
 }
 
@@ -222,7 +224,7 @@ void WindowOptions::Check() const {
 std::string ViewerKeyHelp() {
   return "keys: mouse left drag orbit | right/middle drag pan | wheel zoom\n"
          "      1 no shadows  2 planar  3 shadow map  4 PCF  5 volumes  6 blob  [ ] PCF radius\n"
-         "      T texture atlas/projective/shaded/matcap   C cameras  P points  M mesh  G grid\n"
+         "      T texture atlas/projective/shaded/matcap   C cameras  P points  M mesh  G grid  H glare\n"
          "      arrows move the light  L point/directional light  + - exposure\n"
          "      N / B next / previous source camera   R reset view   S screenshot   Esc quit\n";
 }

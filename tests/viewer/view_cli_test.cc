@@ -191,6 +191,10 @@ TEST(ViewWindow, SyntheticInputDrivesEveryControl) {
   EXPECT_TRUE(title_shows("light az 50")) << title();
   key("Up");
   EXPECT_TRUE(title_shows("light az 50 el 55")) << title();
+  key("h");
+  EXPECT_TRUE(title_shows("| glare")) << title();
+  key("h");
+  EXPECT_TRUE(WaitFor([&] { return title().find("glare") == std::string::npos; })) << title();
 
   // A left drag of 100 pixels to the right orbits 30 degrees; the wheel zooms in by 10%.
   const double azimuth = TitleNumber(title(), "view az ");

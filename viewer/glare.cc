@@ -1,0 +1,94 @@
+#include "viewer/glare.h"
+
+#include <stdexcept>
+#include <string>
+
+#include "viewer/shaders.h"
+
+namespace parallax {
+namespace {
+
+std::string GlareSource(const char* body) {
+  return std::string("#version 330 core\n") + shaders::kGlareExcess + body;
+}
+
+// An RGBA32F texture bilinear and clamped to its edge, and a framebuffer drawing into it.
+void MakeTarget(GlTexture& texture, GlFramebuffer& framebuffer, int width, int height) {
+  texture = gpu::MakeTextureOnScratchUnit();
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  gpu::SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
+  framebuffer = MakeGlFramebuffer();
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.Get(), 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("GL: glare frame buffer incomplete");
+  }
+}
+
+}  // namespace
+
+Glare::Glare()
+    : first_level_("glare first level", shaders::kToneMapVertex,
+                   GlareSource(shaders::kGlareFirstLevelFragment).c_str()),
+      composite_("glare composite", shaders::kToneMapVertex, GlareSource(shaders::kGlareCompositeFragment).c_str()),
+      empty_vao_(MakeGlVertexArray()) {}
+
+void Glare::Resize(int width, int height) {
+  if (width == width_ && height == height_) return;
+  width_ = width;
+  height_ = height;
+  // Padded so that every level is exactly half the one before: a linear blit then averages
+  // 2x2 texels, and each level holds the light of the first.
+  constexpr int kMultiple = 1 << kLevels;
+  extent_width_ = (width + kMultiple - 1) / kMultiple * kMultiple;
+  extent_height_ = (height + kMultiple - 1) / kMultiple * kMultiple;
+  for (int level = 0; level < kLevels; ++level) {
+    MakeTarget(levels_[level], level_framebuffers_[level], extent_width_ >> (level + 1), extent_height_ >> (level + 1));
+  }
+  MakeTarget(result_, result_framebuffer_, width, height);
+}
+
+void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
+  Resize(eye.width, eye.height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_STENCIL_TEST);
+  glBindVertexArray(empty_vao_.Get());
+  glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
+  glBindTexture(GL_TEXTURE_2D, eye.hdr.Get());
+  // The excess, 2x2 averaged, into the first level.
+  glBindFramebuffer(GL_FRAMEBUFFER, level_framebuffers_[0].Get());
+  glViewport(0, 0, extent_width_ / 2, extent_height_ / 2);
+  first_level_.Use();
+  first_level_.Set("u_hdr", gpu::kScratchUnit);
+  first_level_.Set("u_exposure", exposure);
+  first_level_.Set("u_white", white);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  // Each further level the 2x2 average of the one before.
+  for (int level = 1; level < kLevels; ++level) {
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, level_framebuffers_[level - 1].Get());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, level_framebuffers_[level].Get());
+    const int from_width = extent_width_ >> level, from_height = extent_height_ >> level;
+    glBlitFramebuffer(0, 0, from_width, from_height, 0, 0, from_width / 2, from_height / 2, GL_COLOR_BUFFER_BIT,
+                      GL_LINEAR);
+  }
+  // The frame less its excess, plus the halo.
+  for (int level = 0; level < kLevels; ++level) {
+    glActiveTexture(GL_TEXTURE0 + gpu::kGlareUnit + level);
+    glBindTexture(GL_TEXTURE_2D, levels_[level].Get());
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glBindFramebuffer(GL_FRAMEBUFFER, result_framebuffer_.Get());
+  glViewport(0, 0, width_, height_);
+  composite_.Use();
+  composite_.Set("u_hdr", gpu::kScratchUnit);
+  composite_.Set("u_exposure", exposure);
+  composite_.Set("u_white", white);
+  for (int level = 0; level < kLevels; ++level) {
+    composite_.Set(("u_levels[" + std::to_string(level) + "]").c_str(), gpu::kGlareUnit + level);
+  }
+  composite_.Set("u_extent", Eigen::Vector2f(static_cast<float>(extent_width_), static_cast<float>(extent_height_)));
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+}
+
+}  // namespace parallax
