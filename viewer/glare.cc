@@ -30,6 +30,7 @@ void MakeTarget(GlTexture& texture, GlFramebuffer& framebuffer, int width, int h
 Glare::Glare()
     : first_level_("glare first level", shaders::kToneMapVertex,
                    GlareSource(shaders::kGlareFirstLevelFragment).c_str()),
+      upsample_("glare upsample", shaders::kToneMapVertex, shaders::kGlareUpsampleFragment),
       composite_("glare composite", shaders::kToneMapVertex, GlareSource(shaders::kGlareCompositeFragment).c_str()),
       empty_vao_(MakeGlVertexArray()) {}
 
@@ -71,21 +72,33 @@ void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
     glBlitFramebuffer(0, 0, from_width, from_height, 0, 0, from_width / 2, from_height / 2, GL_COLOR_BUFFER_BIT,
                       GL_LINEAR);
   }
-  // The frame less its excess, plus the halo.
-  for (int level = 0; level < kLevels; ++level) {
-    glActiveTexture(GL_TEXTURE0 + gpu::kGlareUnit + level);
-    glBindTexture(GL_TEXTURE_2D, levels_[level].Get());
+  // From the coarsest, each level added to the next finer one, upsampled: the first then holds
+  // every level, each spread over its own width.
+  upsample_.Use();
+  upsample_.Set("u_coarser", gpu::kGlareUnit);
+  glActiveTexture(GL_TEXTURE0 + gpu::kGlareUnit);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE);
+  for (int level = kLevels - 2; level >= 0; --level) {
+    const int width = extent_width_ >> (level + 1), height = extent_height_ >> (level + 1);
+    glBindTexture(GL_TEXTURE_2D, levels_[level + 1].Get());
+    glBindFramebuffer(GL_FRAMEBUFFER, level_framebuffers_[level].Get());
+    glViewport(0, 0, width, height);
+    upsample_.Set("u_size", Eigen::Vector2f(static_cast<float>(width), static_cast<float>(height)));
+    glDrawArrays(GL_TRIANGLES, 0, 3);
   }
+  glDisable(GL_BLEND);
+  // The frame less its excess, plus the halo: the levels' mean.
+  glBindTexture(GL_TEXTURE_2D, levels_[0].Get());
   glActiveTexture(GL_TEXTURE0);
   glBindFramebuffer(GL_FRAMEBUFFER, result_framebuffer_.Get());
   glViewport(0, 0, width_, height_);
   composite_.Use();
   composite_.Set("u_hdr", gpu::kScratchUnit);
+  composite_.Set("u_halo", gpu::kGlareUnit);
   composite_.Set("u_exposure", exposure);
   composite_.Set("u_white", white);
-  for (int level = 0; level < kLevels; ++level) {
-    composite_.Set(("u_levels[" + std::to_string(level) + "]").c_str(), gpu::kGlareUnit + level);
-  }
+  composite_.Set("u_levels", static_cast<float>(kLevels));
   composite_.Set("u_extent", Eigen::Vector2f(static_cast<float>(extent_width_), static_cast<float>(extent_height_)));
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);

@@ -3,9 +3,9 @@
 // or a lens scatters it (the seed's HDR rendering: with a float frame "glare can be shown").
 // What each channel of a pixel holds over the white is taken out (the pixel then shows white
 // where every channel was over it, as a clipped one would) and added back blurred: a pyramid
-// of 2x2 averages from 2 to 64 pixels, each level upsampled bilinearly, the six averaged. Every
-// level keeps the light it was given, so the frame keeps its light, less what spreads past its
-// border. Needs a current GL context.
+// of 2x2 averages from 2 to 64 pixels, each level upsampled bilinearly level by level, the six
+// averaged. Every level keeps the light it was given, so the frame keeps its light, less what
+// spreads past its border. Needs a current GL context.
 #include <array>
 
 #include "viewer/gl.h"
@@ -30,7 +30,7 @@ class Glare {
  private:
   void Resize(int width, int height);
 
-  GlProgram first_level_, composite_;
+  GlProgram first_level_, upsample_, composite_;
   GlVertexArray empty_vao_;  // The screen triangle has no vertex buffer.
   std::array<GlTexture, kLevels> levels_;
   std::array<GlFramebuffer, kLevels> level_framebuffers_;

@@ -14,7 +14,7 @@
 namespace parallax::gpu {
 
 // Texture units: atlas 0, shadow map 1, photos 2..4, projector depth maps 5..7, matcap 8, the
-// glare's pyramid 9..14. Textures are created on a unit of their own, so making one never
+// glare's levels 9. Textures are created on a unit of their own, so making one never
 // disturbs what a sampler is bound to.
 constexpr int kAtlasUnit = 0, kShadowUnit = 1, kPhotoUnit = 2, kProjectorDepthUnit = 5, kMatcapUnit = 8;
 constexpr int kGlareUnit = 9;

@@ -330,17 +330,23 @@ void main() {
 }
 )";
 
+const char* const kGlareUpsampleFragment = R"(#version 330 core
+uniform sampler2D u_coarser;
+uniform vec2 u_size;  // This level's.
+layout(location = 0) out vec4 o_halo;
+void main() { o_halo = vec4(texture(u_coarser, gl_FragCoord.xy / u_size).rgb, 0.0); }
+)";
+
 const char* const kGlareCompositeFragment = R"(
 uniform sampler2D u_hdr;
-uniform sampler2D u_levels[6];
-uniform vec2 u_extent;  // The pixels the pyramid covers: the frame padded to a multiple of 64.
+uniform sampler2D u_halo;  // The pyramid's first level, every coarser one added to it.
+uniform vec2 u_extent;     // The pixels the pyramid covers: the frame padded to a multiple of 64.
+uniform float u_levels;
 layout(location = 0) out vec4 o_color;
 void main() {
   vec3 c = max(texelFetch(u_hdr, ivec2(gl_FragCoord.xy), 0).rgb, vec3(0.0));
-  vec2 uv = gl_FragCoord.xy / u_extent;
-  vec3 halo = texture(u_levels[0], uv).rgb + texture(u_levels[1], uv).rgb + texture(u_levels[2], uv).rgb +
-              texture(u_levels[3], uv).rgb + texture(u_levels[4], uv).rgb + texture(u_levels[5], uv).rgb;
-  o_color = vec4(c - Excess(c) + halo / 6.0, 1.0);
+  vec3 halo = texture(u_halo, gl_FragCoord.xy / u_extent).rgb / u_levels;
+  o_color = vec4(c - Excess(c) + halo, 1.0);
 }
 )";
 

@@ -36,6 +36,8 @@ extern const char* const kToneMapFragment;
 extern const char* const kGlareExcess;
 // The excess of 2x2 pixels of the float frame averaged: the first level of the pyramid.
 extern const char* const kGlareFirstLevelFragment;
+// A coarser level upsampled, to be added to the next finer one (complete, with its #version).
+extern const char* const kGlareUpsampleFragment;
 // The float frame less its excess, plus the pyramid's levels upsampled and averaged.
 extern const char* const kGlareCompositeFragment;
 
