@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 
 #include "core/error.h"
 
@@ -72,32 +71,37 @@ const std::array<MarchingCubesCase, 256>& MarchingCubesTable() {
   return table;
 }
 
-TriangleMesh MarchingCubes(const SampledField& field) {
+void IsoSurfaceMesher::Add(const SampledField& field) {
   const Eigen::Vector3i& n = field.size;
   if ((n.array() < 0).any() || field.values.size() != static_cast<size_t>(n.x()) * n.y() * n.z()) {
-    throw BadInputError("marching cubes: " + std::to_string(field.values.size()) + " samples for a grid of " +
+    throw BadInputError("marching cubes: " + std::to_string(field.values.size()) + " samples for a box of " +
                         std::to_string(n.x()) + " x " + std::to_string(n.y()) + " x " + std::to_string(n.z()));
   }
   if (!(field.spacing > 0)) throw BadInputError("marching cubes: the spacing must be positive");
+  if (!grid_) grid_.emplace(field.origin, field.spacing);
+  if (grid_->first != field.origin || grid_->second != field.spacing) {
+    throw BadInputError("marching cubes: boxes of different grids");
+  }
+  constexpr int kIndexLimit = 1 << 19;
+  const Eigen::Vector3i last = field.first + n;
+  if ((field.first.array() < -kIndexLimit).any() || (last.array() > kIndexLimit).any()) {
+    throw BadInputError("marching cubes: a sample index beyond 2^19");
+  }
   const std::array<MarchingCubesCase, 256>& table = MarchingCubesTable();
-  TriangleMesh mesh;
-  // A grid edge is its lower sample's index and its axis; each crossed edge is one vertex.
-  std::unordered_map<uint64_t, int> vertex_of_edge;
-  const auto sample_index = [&](const Eigen::Vector3i& p) {
-    return (static_cast<uint64_t>(p.z()) * n.y() + p.y()) * n.x() + p.x();
-  };
   const auto vertex = [&](const Eigen::Vector3i& cell, int edge, const std::array<float, 8>& values) {
     const auto [a, b] = kEdgeCorners[edge];
-    const Eigen::Vector3i pa = cell + Eigen::Vector3i(a & 1, (a >> 1) & 1, (a >> 2) & 1);
-    const Eigen::Vector3i pb = cell + Eigen::Vector3i(b & 1, (b >> 1) & 1, (b >> 2) & 1);
-    const uint64_t key = sample_index(pa) * 3 + static_cast<uint64_t>(edge / 4);
-    const auto [found, inserted] = vertex_of_edge.try_emplace(key, static_cast<int>(mesh.vertices.size()));
+    const Eigen::Vector3i pa = field.first + cell + Eigen::Vector3i(a & 1, (a >> 1) & 1, (a >> 2) & 1);
+    const Eigen::Vector3i pb = field.first + cell + Eigen::Vector3i(b & 1, (b >> 1) & 1, (b >> 2) & 1);
+    const Eigen::Array<uint64_t, 3, 1> biased = (pa.array() + kIndexLimit).cast<uint64_t>();
+    const uint64_t key = (((biased.z() << 20 | biased.y()) << 20 | biased.x()) << 2) | static_cast<uint64_t>(edge / 4);
+    const auto [found, inserted] = vertex_of_edge_.try_emplace(key, static_cast<int>(mesh_.vertices.size()));
     if (inserted) {
       // The signs differ, so the denominator is not zero; t in [0, 1].
       const double value_a = values[a], value_b = values[b];
       const double t = value_a / (value_a - value_b);
-      const Eigen::Vector3d position = field.origin + field.spacing * (pa.cast<double>() + t * (pb - pa).cast<double>());
-      mesh.vertices.push_back(position.cast<float>());
+      const Eigen::Vector3d position =
+          field.origin + field.spacing * (pa.cast<double>() + t * (pb - pa).cast<double>());
+      mesh_.vertices.push_back(position.cast<float>());
     }
     return found->second;
   };
@@ -115,13 +119,18 @@ TriangleMesh MarchingCubes(const SampledField& field) {
         if (!known || mask == 0 || mask == 255) continue;
         const Eigen::Vector3i cell(x, y, z);
         for (const std::array<int, 3>& triangle : table[mask].triangles) {
-          mesh.triangles.emplace_back(vertex(cell, triangle[0], values), vertex(cell, triangle[1], values),
-                                      vertex(cell, triangle[2], values));
+          mesh_.triangles.emplace_back(vertex(cell, triangle[0], values), vertex(cell, triangle[1], values),
+                                       vertex(cell, triangle[2], values));
         }
       }
     }
   }
-  return mesh;
+}
+
+TriangleMesh MarchingCubes(const SampledField& field) {
+  IsoSurfaceMesher mesher;
+  mesher.Add(field);
+  return mesher.Take();
 }
 
 }  // namespace parallax

@@ -166,6 +166,11 @@ TEST(MarchingCubes, UnknownSamplesMakeNoSurfaceAndBadGridsAreRefused) {
   EXPECT_GT(half.triangles.size(), whole / 3);
   EXPECT_LT(half.triangles.size(), 2 * whole / 3);
 
+  IsoSurfaceMesher mesher;
+  mesher.Add(field);
+  SampledField other_grid = field;
+  other_grid.origin.x() += 0.05;
+  EXPECT_THROW(mesher.Add(other_grid), BadInputError);
   field.values.pop_back();
   EXPECT_THROW(MarchingCubes(field), BadInputError);
   field.values.push_back(1);
