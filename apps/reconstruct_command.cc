@@ -152,6 +152,18 @@ void AddDenseOptions(CLI::App& command, ReconstructArguments& arguments) {
                      "seed of the depth stage's random search (default 0): runs with other seeds "
                      "measure the run-to-run spread of the depth and of what is built from it");
   command.add_flag("--no-mesh", arguments.no_mesh, "stop after depth maps and the fused cloud (no textured mesh)");
+  const std::map<std::string, Mesher> meshers{{"poisson", Mesher::kPoisson}, {"tsdf", Mesher::kTsdf}};
+  command.add_option("--mesher", arguments.options.mesher,
+                     "poisson|tsdf: the mesh's surface from the fused cloud by screened Poisson (default), or "
+                     "from the depth maps fused into a truncated signed-distance volume by marching cubes")
+      ->transform(CLI::CheckedTransformer(meshers, CLI::ignore_case));
+  command.add_option("--tsdf-voxel", arguments.options.tsdf_voxel_pixels,
+                     "--mesher tsdf: the voxel in depth-map pixels at the maps' median depth (default 4)")
+      ->check(CLI::Range(0.25, 64.0));
+  command.add_option("--tsdf-weight", arguments.options.tsdf_min_weight,
+                     "--mesher tsdf: how many depth maps must have written each voxel of a cell for it to make "
+                     "surface (default 2)")
+      ->check(CLI::Range(0.5, 1000.0));
 }
 
 // The options as the command line set them, checked; submitted to Slurm or run here.

@@ -85,6 +85,9 @@ void MeshOptions::Check() const {
   RequireOption(poisson_depth >= 5 && poisson_depth <= 14, "MeshOptions.poisson_depth", poisson_depth, "[5, 14]");
   RequireOption(max_cells_from_data > 0, "MeshOptions.max_cells_from_data", max_cells_from_data, "> 0");
   RequireOption(poisson_trim >= 0, "MeshOptions.poisson_trim", poisson_trim, ">= 0");
+  RequireOption(tsdf_voxel_pixels > 0, "MeshOptions.tsdf_voxel_pixels", tsdf_voxel_pixels, "> 0");
+  RequireOption(tsdf_truncation_voxels >= 1, "MeshOptions.tsdf_truncation_voxels", tsdf_truncation_voxels, ">= 1");
+  RequireOption(tsdf_min_weight > 0, "MeshOptions.tsdf_min_weight", tsdf_min_weight, "> 0");
   RequireOption(display_max_triangles >= 1, "MeshOptions.display_max_triangles",
                 static_cast<double>(display_max_triangles), ">= 1");
   support.Check();
@@ -115,7 +118,12 @@ void to_json(nlohmann::json& json, const MeshSummary& mesh) {
           {"display_triangles", mesh.display_triangles},
           {"pieces", mesh.pieces},
           {"dropped_pieces", mesh.dropped_pieces},
-          {"dropped_triangles", mesh.dropped_triangles}};
+          {"dropped_triangles", mesh.dropped_triangles},
+          {"mesher", mesh.mesher}};
+  if (mesh.mesher == "tsdf") {
+    json["voxel_size"] = mesh.voxel_size;
+    json["voxel_blocks"] = mesh.voxel_blocks;
+  }
 }
 
 void from_json(const nlohmann::json& json, MeshSummary& mesh) {
@@ -130,6 +138,9 @@ void from_json(const nlohmann::json& json, MeshSummary& mesh) {
   json.at("pieces").get_to(mesh.pieces);
   json.at("dropped_pieces").get_to(mesh.dropped_pieces);
   json.at("dropped_triangles").get_to(mesh.dropped_triangles);
+  mesh.mesher = json.value("mesher", "poisson");  // Summaries from before the choice.
+  mesh.voxel_size = json.value("voxel_size", 0.0);
+  mesh.voxel_blocks = json.value("voxel_blocks", size_t{0});
 }
 
 }  // namespace parallax

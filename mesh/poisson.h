@@ -6,6 +6,7 @@
 // `colmap poisson_mesher` and writes <ws>/mesh/ and <ws>/mesh_display/, is
 // pipeline/mesh_workspace.h.
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,7 +19,20 @@
 
 namespace parallax {
 
+// What makes the surface: screened Poisson over the fused cloud (colmap's poisson_mesher,
+// trimmed to the data), or the depth maps fused into a truncated signed-distance volume and its
+// zero level by marching cubes (mesh/tsdf_volume.h).
+enum class Mesher { kPoisson, kTsdf };
+
 struct MeshOptions {
+  Mesher mesher = Mesher::kPoisson;
+  // kTsdf: the voxel in depth-map pixels at the views' median depth, the truncation in voxels,
+  // and how many depth maps must have written each corner of a cell for it to make surface
+  // (docs/mesh.md: on the courtyard 2 px voxels gave 7 times the triangles for 0.1 dB, a weight
+  // of 1 fragments where maps disagree).
+  double tsdf_voxel_pixels = 4;
+  double tsdf_truncation_voxels = 3;
+  float tsdf_min_weight = 2;
   // Octree depth of the Poisson solve: cells of (scene extent / 2^depth).
   int poisson_depth = 10;
   // Poisson closes the surface everywhere, also where no photo saw anything; a triangle is
@@ -42,7 +56,7 @@ struct MeshOptions {
 MeshOptions MeshOptionsFor(Quality quality);
 
 struct MeshSummary {
-  size_t poisson_triangles = 0;
+  size_t poisson_triangles = 0;  // The raw surface's: Poisson's, or the volume's (tsdf).
   size_t triangles = 0;  // After trimming and dropping floaters.
   size_t vertices = 0;
   int texels_per_edge = 0;
@@ -52,6 +66,9 @@ struct MeshSummary {
   size_t pieces = 0;             // Connected pieces of the trimmed surface ...
   size_t dropped_pieces = 0;     // ... the floaters among them ...
   size_t dropped_triangles = 0;  // ... and their triangles.
+  std::string mesher = "poisson";
+  double voxel_size = 0;  // tsdf: scene units.
+  size_t voxel_blocks = 0;  // tsdf: blocks of 8^3 voxels made.
 };
 
 // <ws>/mesh/summary.json and report.json's "mesh" section.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@
 
 namespace parallax {
 namespace {
+
+// Four depths within this ratio are one surface, interpolated between (core/depth_map.h).
+constexpr double kOneSurface = 1.05;
 
 int FloorDiv(int value, int divisor) { return value >= 0 ? value / divisor : -((-value + divisor - 1) / divisor); }
 
@@ -71,11 +75,12 @@ void TsdfVolume::Integrate(const Camera& camera, const Rigid3d& cam_from_world, 
                        Eigen::Vector3d::Constant(0.5));
           const Eigen::Vector3d p = cam_from_world * centre;
           if (!(p.z() > 0)) continue;
-          const double u = fx * p.x() / p.z() + cx, v = fy * p.y() / p.z() + cy;
-          if (!(u >= 0 && v >= 0 && u < depth.Width() && v < depth.Height())) continue;
-          const double d = depth.At(static_cast<int>(u), static_cast<int>(v));
-          const double distance = d - p.z();
-          if (!(d > 0) || distance < -truncation) continue;  // No depth, or hidden behind the surface.
+          // The depth interpolated where the four pixels around lie on one surface.
+          const std::optional<double> d =
+              SampleDepth(depth, Eigen::Vector2d(fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy), kOneSurface);
+          if (!d) continue;
+          const double distance = *d - p.z();
+          if (distance < -truncation) continue;  // Hidden behind the surface.
           Voxel& cell = (*block)[(k * kBlockSide + j) * kBlockSide + l];
           const double clipped = std::min(1.0, distance / truncation);
           const double old_weight = cell.weight, total = old_weight + static_cast<double>(weight);

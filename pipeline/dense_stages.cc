@@ -177,23 +177,27 @@ double FusedPixelShare(const Workspace& workspace, const DepthRequest& request) 
 
 }  // namespace
 
-Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
-                const std::string& color_gains_key, const Colmap& colmap, Progress& progress) {
+Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const ReconstructOptions& reconstruct,
+                const std::string& depth_key, const std::string& color_gains_key, const Colmap& colmap,
+                Progress& progress) {
+  MeshOptions options = MeshOptionsFor(request.quality);
+  options.mesher = reconstruct.mesher;
+  if (reconstruct.tsdf_voxel_pixels > 0) options.tsdf_voxel_pixels = reconstruct.tsdf_voxel_pixels;
+  if (reconstruct.tsdf_min_weight > 0) options.tsdf_min_weight = static_cast<float>(reconstruct.tsdf_min_weight);
   Stage stage;
   stage.name = "mesh";
-  stage.key = Hasher()
-                  .Add(depth_key)
-                  .Add(color_gains_key)
-                  .Add(kFusionVersion)
-                  .Add(kMeshVersion)
-                  .Add(static_cast<uint64_t>(request.quality))
-                  .Hex();
+  Hasher key;
+  key.Add(depth_key).Add(color_gains_key).Add(kFusionVersion).Add(kMeshVersion).Add(static_cast<uint64_t>(request.quality));
+  if (options.mesher == Mesher::kTsdf) {
+    key.Add("tsdf-1").Add(std::to_string(options.tsdf_voxel_pixels)).Add(std::to_string(options.tsdf_min_weight));
+  }
+  stage.key = key.Hex();
   stage.outputs = {workspace.MeshSummary()};
-  stage.run = [workspace, request, &colmap, &progress] {
-    MeshOptions options = MeshOptionsFor(request.quality);
+  stage.run = [workspace, request, options, &colmap, &progress] {
+    MeshOptions trimmed = options;
     // A cloud fused from fewer pixels is less dense where it is complete.
-    options.poisson_trim += std::log2(FusedPixelShare(workspace, request));
-    const MeshSummary mesh = MeshWorkspace(workspace, colmap, options, progress);
+    trimmed.poisson_trim += std::log2(FusedPixelShare(workspace, request));
+    const MeshSummary mesh = MeshWorkspace(workspace, colmap, trimmed, progress);
     WriteFileAtomically(workspace.MeshSummary(), nlohmann::json(mesh).dump(2) + "\n");
   };
   return stage;

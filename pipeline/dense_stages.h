@@ -64,8 +64,11 @@ std::string EnsureColorGains(const Workspace& workspace);
 Stage FusionStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
                   const std::string& color_gains_key, Progress& progress);
 
-Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const std::string& depth_key,
-                const std::string& color_gains_key, const Colmap& colmap, Progress& progress);
+// The surface by options.mesher (and its volume's voxel and weight); a Poisson stage keeps the
+// key it had before the choice.
+Stage MeshStage(const Workspace& workspace, const DepthRequest& request, const ReconstructOptions& options,
+                const std::string& depth_key, const std::string& color_gains_key, const Colmap& colmap,
+                Progress& progress);
 
 // The key that identifies a workspace's undistorted model: the one its undistort stage
 // completed with, or, for a workspace not made by reconstruct, a hash of its model files.

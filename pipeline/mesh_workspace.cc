@@ -1,5 +1,6 @@
 #include "pipeline/mesh_workspace.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "geometry/ply.h"
 #include "geometry/simplify.h"
 #include "mesh/support.h"
+#include "mesh/tsdf_volume.h"
 
 namespace parallax {
 namespace fs = std::filesystem;
@@ -80,14 +82,71 @@ TriangleMesh TrimmedPoissonSurface(const Workspace& workspace, const Colmap& col
   return trimmed;
 }
 
+// The depth maps of `model`'s photos fused into a signed-distance volume (mesh/tsdf_volume.h),
+// each at its own size with its camera scaled to it; the voxel is options.tsdf_voxel_pixels of
+// a map's pixels at the median over the maps of their median depth, so it follows the depth
+// stage's resolution as Poisson's octree follows the cloud's extent. Cells whose voxels fewer
+// than options.tsdf_min_weight maps wrote make no surface; pieces no two maps support go with
+// the floaters after.
+TriangleMesh TsdfSurface(const Workspace& workspace, const SparseModel& model, const MeshOptions& options,
+                         Progress& progress, MeshSummary& summary) {
+  struct MapView {
+    Camera camera;
+    Rigid3d cam_from_world;
+    DepthMap depth;
+  };
+  std::vector<MapView> views;
+  std::vector<double> footprints;  // Scene units per map pixel at the map's median depth.
+  for (const SparseImage& image : model.Images()) {
+    const fs::path path = workspace.Depth(image.name);
+    if (!fs::exists(path)) continue;
+    MapView view{model.CameraById(image.camera_id), image.cam_from_world, ReadDepthExr(path)};
+    const double sx = static_cast<double>(view.depth.Width()) / static_cast<double>(view.camera.width);
+    const double sy = static_cast<double>(view.depth.Height()) / static_cast<double>(view.camera.height);
+    view.camera = MakePinholeCamera(view.camera.id, static_cast<uint64_t>(view.depth.Width()),
+                                    static_cast<uint64_t>(view.depth.Height()), sx * view.camera.FocalX(),
+                                    sy * view.camera.FocalY(), sx * view.camera.PrincipalX(),
+                                    sy * view.camera.PrincipalY());
+    std::vector<float> depths;
+    for (const float d : view.depth.Values()) {
+      if (d > 0) depths.push_back(d);
+    }
+    if (depths.empty()) continue;
+    std::nth_element(depths.begin(), depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2), depths.end());
+    footprints.push_back(static_cast<double>(depths[depths.size() / 2]) / view.camera.FocalX());
+    views.push_back(std::move(view));
+  }
+  if (views.empty()) throw BadInputError(workspace.DepthDir().string() + ": no depth maps to fuse into a volume");
+  std::nth_element(footprints.begin(), footprints.begin() + static_cast<std::ptrdiff_t>(footprints.size() / 2),
+                   footprints.end());
+  TsdfOptions tsdf;
+  tsdf.voxel_size = options.tsdf_voxel_pixels * footprints[footprints.size() / 2];
+  tsdf.truncation = options.tsdf_truncation_voxels * tsdf.voxel_size;
+  TsdfVolume volume(tsdf);
+  for (size_t i = 0; i < views.size(); ++i) {
+    progress.Update("volume", i, views.size());
+    volume.Integrate(views[i].camera, views[i].cam_from_world, views[i].depth);
+  }
+  progress.Update("volume", views.size(), views.size());
+  summary.mesher = "tsdf";
+  summary.voxel_size = tsdf.voxel_size;
+  summary.voxel_blocks = volume.Blocks();
+  TriangleMesh surface = volume.Mesh(options.tsdf_min_weight);
+  summary.poisson_triangles = surface.triangles.size();
+  return surface;
+}
+
 }  // namespace
 
 MeshSummary MeshWorkspace(const Workspace& workspace, const Colmap& colmap, const MeshOptions& options,
                           Progress& progress) {
   options.Check();
   MeshSummary summary;
-  const TriangleMesh trimmed = TrimmedPoissonSurface(workspace, colmap, options, progress, summary.poisson_triangles);
   const SparseModel model = ReadSparseModelWithoutKeypoints(workspace.Sparse());
+  const TriangleMesh trimmed =
+      options.mesher == Mesher::kTsdf
+          ? TsdfSurface(workspace, model, options, progress, summary)
+          : TrimmedPoissonSurface(workspace, colmap, options, progress, summary.poisson_triangles);
   progress.Update("floaters", 0, 1);
   SupportSummary support;
   const TriangleMesh surface =

@@ -1,6 +1,7 @@
 #pragma once
 // The mesh stage over a workspace: <ws>/fused.ply -> `colmap poisson_mesher` (screened Poisson,
-// watertight) -> trimmed to where the cloud has data (mesh/poisson.h) -> without the pieces
+// watertight) -> trimmed to where the cloud has data (mesh/poisson.h), or with Mesher::kTsdf
+// <ws>/depth's maps fused into a signed-distance volume and its zero level -> without the pieces
 // <ws>/depth's maps do not support (mesh/support.h) -> textured from the photos of
 // <ws>/images (mesh/texture.h) -> <ws>/mesh/mesh.obj|.mtl|.png|.glb, and a simplified copy for
 // display -> <ws>/mesh_display/.

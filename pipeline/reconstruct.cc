@@ -226,7 +226,7 @@ void RunDenseStages(const SfmContext& sfm, const std::string& undistort_key, Sta
     summary.notes.push_back("mesh: not built (--no-mesh)");
     return;
   }
-  graph.Run(MeshStage(paths, depth_request, depth.key, color_gains.key, sfm.colmap, sfm.progress));
+  graph.Run(MeshStage(paths, depth_request, options, depth.key, color_gains.key, sfm.colmap, sfm.progress));
   summary.mesh = nlohmann::json::parse(ReadFileBytes(paths.MeshSummary())).get<MeshSummary>();
 }
 

@@ -8,6 +8,7 @@
 
 #include "core/camera.h"
 #include "core/quality.h"
+#include "mesh/poisson.h"
 #include "sfm/plausibility.h"
 
 namespace parallax {
@@ -121,6 +122,12 @@ struct ReconstructOptions {
   uint32_t mvs_seed = 0;
   // After depth: Poisson mesh, trimmed and textured (the mesh stage, pipeline/dense_stages.h).
   bool build_mesh = true;
+  // What makes the mesh's surface: Poisson over the fused cloud, or the depth maps fused into
+  // a signed-distance volume (mesh/poisson.h), with its voxel in depth-map pixels and the maps'
+  // weight a cell needs (0: MeshOptions' defaults).
+  Mesher mesher = Mesher::kPoisson;
+  double tsdf_voxel_pixels = 0;
+  double tsdf_min_weight = 0;
   void Check() const;  // Throws UsageError naming the field.
 };
 
