@@ -1,6 +1,5 @@
 #include "viewer/glare.h"
 
-#include <stdexcept>
 #include <string>
 
 #include "viewer/shaders.h"
@@ -10,19 +9,6 @@ namespace {
 
 std::string GlareSource(const char* body) {
   return std::string("#version 330 core\n") + shaders::kGlareExcess + body;
-}
-
-// An RGBA32F texture bilinear and clamped to its edge, and a framebuffer drawing into it.
-void MakeTarget(GlTexture& texture, GlFramebuffer& framebuffer, int width, int height) {
-  texture = gpu::MakeTextureOnScratchUnit();
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
-  gpu::SetTextureParameters(GL_LINEAR, GL_CLAMP_TO_EDGE);
-  framebuffer = MakeGlFramebuffer();
-  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer.Get());
-  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.Get(), 0);
-  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-    throw std::runtime_error("GL: glare frame buffer incomplete");
-  }
 }
 
 }  // namespace
@@ -44,9 +30,9 @@ void Glare::Resize(int width, int height) {
   extent_width_ = (width + kMultiple - 1) / kMultiple * kMultiple;
   extent_height_ = (height + kMultiple - 1) / kMultiple * kMultiple;
   for (int level = 0; level < kLevels; ++level) {
-    MakeTarget(levels_[level], level_framebuffers_[level], extent_width_ >> (level + 1), extent_height_ >> (level + 1));
+    levels_[level] = gpu::MakeFloatTarget(extent_width_ >> (level + 1), extent_height_ >> (level + 1), GL_LINEAR);
   }
-  MakeTarget(result_, result_framebuffer_, width, height);
+  result_ = gpu::MakeFloatTarget(width, height, GL_LINEAR);
 }
 
 void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
@@ -57,7 +43,7 @@ void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
   glActiveTexture(GL_TEXTURE0 + gpu::kScratchUnit);
   glBindTexture(GL_TEXTURE_2D, eye.hdr.Get());
   // The excess, 2x2 averaged, into the first level.
-  glBindFramebuffer(GL_FRAMEBUFFER, level_framebuffers_[0].Get());
+  glBindFramebuffer(GL_FRAMEBUFFER, levels_[0].framebuffer.Get());
   glViewport(0, 0, extent_width_ / 2, extent_height_ / 2);
   first_level_.Use();
   first_level_.Set("u_hdr", gpu::kScratchUnit);
@@ -66,8 +52,8 @@ void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
   glDrawArrays(GL_TRIANGLES, 0, 3);
   // Each further level the 2x2 average of the one before.
   for (int level = 1; level < kLevels; ++level) {
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, level_framebuffers_[level - 1].Get());
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, level_framebuffers_[level].Get());
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, levels_[level - 1].framebuffer.Get());
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, levels_[level].framebuffer.Get());
     const int from_width = extent_width_ >> level, from_height = extent_height_ >> level;
     glBlitFramebuffer(0, 0, from_width, from_height, 0, 0, from_width / 2, from_height / 2, GL_COLOR_BUFFER_BIT,
                       GL_LINEAR);
@@ -81,17 +67,17 @@ void Glare::Apply(const gpu::EyeTarget& eye, float exposure, float white) {
   glBlendFunc(GL_ONE, GL_ONE);
   for (int level = kLevels - 2; level >= 0; --level) {
     const int width = extent_width_ >> (level + 1), height = extent_height_ >> (level + 1);
-    glBindTexture(GL_TEXTURE_2D, levels_[level + 1].Get());
-    glBindFramebuffer(GL_FRAMEBUFFER, level_framebuffers_[level].Get());
+    glBindTexture(GL_TEXTURE_2D, levels_[level + 1].texture.Get());
+    glBindFramebuffer(GL_FRAMEBUFFER, levels_[level].framebuffer.Get());
     glViewport(0, 0, width, height);
     upsample_.Set("u_size", Eigen::Vector2f(static_cast<float>(width), static_cast<float>(height)));
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
   glDisable(GL_BLEND);
   // The frame less its excess, plus the halo: the levels' mean.
-  glBindTexture(GL_TEXTURE_2D, levels_[0].Get());
+  glBindTexture(GL_TEXTURE_2D, levels_[0].texture.Get());
   glActiveTexture(GL_TEXTURE0);
-  glBindFramebuffer(GL_FRAMEBUFFER, result_framebuffer_.Get());
+  glBindFramebuffer(GL_FRAMEBUFFER, result_.framebuffer.Get());
   glViewport(0, 0, width_, height_);
   composite_.Use();
   composite_.Set("u_hdr", gpu::kScratchUnit);

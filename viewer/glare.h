@@ -24,18 +24,15 @@ class Glare {
   // into its halo, into Result() (linear light, the eye's size). Leaves the viewport at the
   // eye's size and the depth and stencil tests off.
   void Apply(const gpu::EyeTarget& eye, float exposure, float white);
-  const GlTexture& Result() const { return result_; }
-  const GlFramebuffer& ResultFramebuffer() const { return result_framebuffer_; }
+  const gpu::FloatTarget& Result() const { return result_; }
 
  private:
   void Resize(int width, int height);
 
   GlProgram first_level_, upsample_, composite_;
   GlVertexArray empty_vao_;  // The screen triangle has no vertex buffer.
-  std::array<GlTexture, kLevels> levels_;
-  std::array<GlFramebuffer, kLevels> level_framebuffers_;
-  GlTexture result_;
-  GlFramebuffer result_framebuffer_;
+  std::array<gpu::FloatTarget, kLevels> levels_;
+  gpu::FloatTarget result_;
   int width_ = 0, height_ = 0;
   int extent_width_ = 0, extent_height_ = 0;  // The frame padded to a multiple of 2^kLevels.
 };

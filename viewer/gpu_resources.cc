@@ -197,6 +197,18 @@ GpuMesh UploadMesh(const TriangleMesh& mesh, const std::optional<GroundPlane>& g
   return uploaded;
 }
 
+FloatTarget MakeFloatTarget(int width, int height, GLenum filter) {
+  FloatTarget target{MakeTextureOnScratchUnit(), MakeGlFramebuffer()};
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, nullptr);
+  SetTextureParameters(filter, GL_CLAMP_TO_EDGE);
+  glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer.Get());
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, target.texture.Get(), 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    throw std::runtime_error("GL: float frame buffer incomplete");
+  }
+  return target;
+}
+
 void SetTextureParameters(GLenum filter, GLenum wrap) {
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, static_cast<GLint>(filter));
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, static_cast<GLint>(filter));

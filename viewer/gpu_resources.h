@@ -78,6 +78,14 @@ GlTexture UploadSrgbTexture(const Image& image);
 // (or refilled, when `texture` already holds one) on `unit`.
 void UploadFloatTexture(GlTexture& texture, const std::vector<float>& texels, int size, int unit);
 
+// An RGBA32F texture (`filter`, clamped to its edge), made on the scratch unit, and a
+// framebuffer drawing into it.
+struct FloatTarget {
+  GlTexture texture;
+  GlFramebuffer framebuffer;
+};
+FloatTarget MakeFloatTarget(int width, int height, GLenum filter);
+
 // A depth texture for hardware comparison, with an FBO that renders into it.
 struct DepthTarget {
   GlTexture texture;

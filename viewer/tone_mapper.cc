@@ -37,20 +37,13 @@ ToneMapper::ToneMapper(FrameClock clock)
 
 double ToneMapper::LogAverageLuminance(const gpu::EyeTarget& eye) {
   constexpr int kMeterWidth = 64, kMeterHeight = 36;
-  if (meter_.Get() == 0) {
-    meter_ = gpu::MakeTextureOnScratchUnit();
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, kMeterWidth, kMeterHeight, 0, GL_RGBA, GL_FLOAT, nullptr);
-    gpu::SetTextureParameters(GL_NEAREST, GL_CLAMP_TO_EDGE);
-    meter_framebuffer_ = MakeGlFramebuffer();
-    glBindFramebuffer(GL_FRAMEBUFFER, meter_framebuffer_.Get());
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, meter_.Get(), 0);
-  }
+  if (meter_.texture.Get() == 0) meter_ = gpu::MakeFloatTarget(kMeterWidth, kMeterHeight, GL_NEAREST);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, eye.hdr_framebuffer.Get());
   glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, meter_framebuffer_.Get());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, meter_.framebuffer.Get());
   glBlitFramebuffer(0, 0, eye.width, eye.height, 0, 0, kMeterWidth, kMeterHeight, GL_COLOR_BUFFER_BIT, GL_LINEAR);
   std::vector<float> texels(static_cast<size_t>(kMeterWidth) * kMeterHeight * 4);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, meter_framebuffer_.Get());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, meter_.framebuffer.Get());
   glReadPixels(0, 0, kMeterWidth, kMeterHeight, GL_RGBA, GL_FLOAT, texels.data());
   double sum_log = 0;
   for (size_t i = 0; i < texels.size(); i += 4) {
@@ -88,8 +81,8 @@ void ToneMapper::Map(const FrameSettings& settings, const gpu::EyeTarget& eye, b
   if (settings.glare) {
     if (!glare_) glare_.emplace();
     glare_->Apply(eye, static_cast<float>(exposure), DisplayWhite(op, settings.white));
-    linear = glare_->Result().Get();
-    linear_framebuffer_ = glare_->ResultFramebuffer().Get();
+    linear = glare_->Result().texture.Get();
+    linear_framebuffer_ = glare_->Result().framebuffer.Get();
   }
   glBindFramebuffer(GL_FRAMEBUFFER, eye.framebuffer.Get());
   const GLenum color_only = GL_COLOR_ATTACHMENT0;

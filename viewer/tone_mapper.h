@@ -39,8 +39,7 @@ class ToneMapper {
   std::optional<Glare> glare_;  // Made at the first frame that asks for it.
   GLuint linear_framebuffer_ = 0;
   GlVertexArray empty_vao_;  // The triangle has no vertex buffer.
-  GlTexture meter_;          // The float frame shrunk, to read its brightness back.
-  GlFramebuffer meter_framebuffer_;
+  gpu::FloatTarget meter_;   // The float frame shrunk, to read its brightness back.
   FrameClock clock_;
   std::optional<double> adapted_luminance_;  // What the eye is adapted to (auto exposure).
   double last_adaptation_ = 0;               // When, on clock_.
