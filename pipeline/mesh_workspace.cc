@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,52 +83,69 @@ TriangleMesh TrimmedPoissonSurface(const Workspace& workspace, const Colmap& col
   return trimmed;
 }
 
+// A photo's depth map and its camera scaled to the map's size (the depth stage's working size).
+struct MapView {
+  Camera camera;
+  Rigid3d cam_from_world;
+  DepthMap depth;
+};
+
+MapView ReadMapView(const Camera& photo_camera, const Rigid3d& cam_from_world, const fs::path& path) {
+  MapView view{photo_camera, cam_from_world, ReadDepthExr(path)};
+  const double sx = static_cast<double>(view.depth.Width()) / static_cast<double>(photo_camera.width);
+  const double sy = static_cast<double>(view.depth.Height()) / static_cast<double>(photo_camera.height);
+  view.camera = MakePinholeCamera(photo_camera.id, static_cast<uint64_t>(view.depth.Width()),
+                                  static_cast<uint64_t>(view.depth.Height()), sx * photo_camera.FocalX(),
+                                  sy * photo_camera.FocalY(), sx * photo_camera.PrincipalX(),
+                                  sy * photo_camera.PrincipalY());
+  return view;
+}
+
+// Scene units per map pixel at the map's median depth; nothing for a map without depth.
+std::optional<double> MedianFootprint(const MapView& view) {
+  std::vector<float> depths;
+  for (const float d : view.depth.Values()) {
+    if (d > 0) depths.push_back(d);
+  }
+  if (depths.empty()) return std::nullopt;
+  const auto middle = depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2);
+  std::nth_element(depths.begin(), middle, depths.end());
+  return static_cast<double>(*middle) / view.camera.FocalX();
+}
+
 // The depth maps of `model`'s photos fused into a signed-distance volume (mesh/tsdf_volume.h),
-// each at its own size with its camera scaled to it; the voxel is options.tsdf_voxel_pixels of
-// a map's pixels at the median over the maps of their median depth, so it follows the depth
-// stage's resolution as Poisson's octree follows the cloud's extent. Cells whose voxels fewer
-// than options.tsdf_min_weight maps wrote make no surface; pieces no two maps support go with
-// the floaters after.
+// each at its own size with its camera scaled to it, read one at a time; the voxel is
+// options.tsdf_voxel_pixels of a map's pixels at the median over the maps of their median
+// depth, so it follows the depth stage's resolution as Poisson's octree follows the cloud's
+// extent. Cells whose voxels fewer than options.tsdf_min_weight maps wrote make no surface;
+// pieces no two maps support go with the floaters after.
 TriangleMesh TsdfSurface(const Workspace& workspace, const SparseModel& model, const MeshOptions& options,
                          Progress& progress, MeshSummary& summary) {
-  struct MapView {
-    Camera camera;
-    Rigid3d cam_from_world;
-    DepthMap depth;
-  };
-  std::vector<MapView> views;
-  std::vector<double> footprints;  // Scene units per map pixel at the map's median depth.
+  std::vector<const SparseImage*> images;
+  std::vector<double> footprints;
   for (const SparseImage& image : model.Images()) {
     const fs::path path = workspace.Depth(image.name);
     if (!fs::exists(path)) continue;
-    MapView view{model.CameraById(image.camera_id), image.cam_from_world, ReadDepthExr(path)};
-    const double sx = static_cast<double>(view.depth.Width()) / static_cast<double>(view.camera.width);
-    const double sy = static_cast<double>(view.depth.Height()) / static_cast<double>(view.camera.height);
-    view.camera = MakePinholeCamera(view.camera.id, static_cast<uint64_t>(view.depth.Width()),
-                                    static_cast<uint64_t>(view.depth.Height()), sx * view.camera.FocalX(),
-                                    sy * view.camera.FocalY(), sx * view.camera.PrincipalX(),
-                                    sy * view.camera.PrincipalY());
-    std::vector<float> depths;
-    for (const float d : view.depth.Values()) {
-      if (d > 0) depths.push_back(d);
-    }
-    if (depths.empty()) continue;
-    std::nth_element(depths.begin(), depths.begin() + static_cast<std::ptrdiff_t>(depths.size() / 2), depths.end());
-    footprints.push_back(static_cast<double>(depths[depths.size() / 2]) / view.camera.FocalX());
-    views.push_back(std::move(view));
+    const std::optional<double> footprint =
+        MedianFootprint(ReadMapView(model.CameraById(image.camera_id), image.cam_from_world, path));
+    if (!footprint) continue;
+    images.push_back(&image);
+    footprints.push_back(*footprint);
   }
-  if (views.empty()) throw BadInputError(workspace.DepthDir().string() + ": no depth maps to fuse into a volume");
-  std::nth_element(footprints.begin(), footprints.begin() + static_cast<std::ptrdiff_t>(footprints.size() / 2),
-                   footprints.end());
+  if (images.empty()) throw BadInputError(workspace.DepthDir().string() + ": no depth maps to fuse into a volume");
+  const auto middle = footprints.begin() + static_cast<std::ptrdiff_t>(footprints.size() / 2);
+  std::nth_element(footprints.begin(), middle, footprints.end());
   TsdfOptions tsdf;
-  tsdf.voxel_size = options.tsdf_voxel_pixels * footprints[footprints.size() / 2];
+  tsdf.voxel_size = options.tsdf_voxel_pixels * *middle;
   tsdf.truncation = options.tsdf_truncation_voxels * tsdf.voxel_size;
   TsdfVolume volume(tsdf);
-  for (size_t i = 0; i < views.size(); ++i) {
-    progress.Update("volume", i, views.size());
-    volume.Integrate(views[i].camera, views[i].cam_from_world, views[i].depth);
+  for (size_t i = 0; i < images.size(); ++i) {
+    progress.Update("volume", i, images.size());
+    const MapView view = ReadMapView(model.CameraById(images[i]->camera_id), images[i]->cam_from_world,
+                                     workspace.Depth(images[i]->name));
+    volume.Integrate(view.camera, view.cam_from_world, view.depth);
   }
-  progress.Update("volume", views.size(), views.size());
+  progress.Update("volume", images.size(), images.size());
   summary.mesher = "tsdf";
   summary.voxel_size = tsdf.voxel_size;
   summary.voxel_blocks = volume.Blocks();
