@@ -15,12 +15,17 @@
 namespace parallax {
 namespace {
 
-void PrintPoses(const PoseEvaluation& evaluation) {
-  std::printf("%-24s %14s %16s\n", "image", "rotation (deg)", "centre (% extent)");
-  for (const ImagePoseError& image : evaluation.images) {
+// Each image's rotation and centre error, a row each under `heading`.
+void PrintPoseErrorRows(const char* heading, const std::vector<ImagePoseError>& errors) {
+  std::printf("%-24s %14s %16s\n", heading, "rotation (deg)", "centre (% extent)");
+  for (const ImagePoseError& image : errors) {
     std::printf("%-24s %14.4f %16.4f\n", image.name.c_str(), image.rotation_error_deg,
                 100 * image.center_error_rel);
   }
+}
+
+void PrintPoses(const PoseEvaluation& evaluation) {
+  PrintPoseErrorRows("image", evaluation.images);
   for (const std::string& name : evaluation.missing) {
     std::printf("%-24s %14s %16s\n", name.c_str(), "missing", "missing");
   }
@@ -95,9 +100,8 @@ void PrintRegisteredPoseErrors(const std::vector<ImagePoseError>& errors) {
   if (errors.empty()) return;
   double rotation_mean = 0;
   double center_mean = 0;
-  std::printf("%-16s %14s %17s\n", "registered pose", "rotation (deg)", "centre (% extent)");
+  PrintPoseErrorRows("registered pose", errors);
   for (const ImagePoseError& error : errors) {
-    std::printf("%-16s %14.4f %17.4f\n", error.name.c_str(), error.rotation_error_deg, 100 * error.center_error_rel);
     rotation_mean += error.rotation_error_deg / static_cast<double>(errors.size());
     center_mean += error.center_error_rel / static_cast<double>(errors.size());
   }
