@@ -35,21 +35,22 @@ bool HasExtension(std::string_view name) {
   return false;
 }
 
-// The first attachment of `framebuffer`, a float frame of `width` x `height`: RGB, top row first.
-Image ReadLinearFrame(GLuint framebuffer, int width, int height) {
+// The first `channels` channels of `attachment` of `framebuffer`, a float target of `width` x
+// `height`, top row first.
+Image ReadFloatAttachment(GLuint framebuffer, GLenum attachment, int width, int height, int channels) {
   std::vector<float> texels(static_cast<size_t>(width) * height * 4);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadBuffer(attachment);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, texels.data());
-  CheckGlError("SceneRenderer::Render read back of the float frame");
-  Image linear(width, height, 3);
+  CheckGlError("SceneRenderer::Render read back");
+  Image image(width, height, channels);
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
     for (int x = 0; x < width; ++x) {
-      for (int c = 0; c < 3; ++c) linear.At(x, y, c) = texels[(row + x) * 4 + c];
+      for (int c = 0; c < channels; ++c) image.At(x, y, c) = texels[(row + x) * 4 + c];
     }
   }
-  return linear;
+  return image;
 }
 
 }  // namespace
@@ -344,24 +345,25 @@ FrameResult SceneRenderer::Render(const ViewCamera& view, const FrameSettings& s
   }
   impl_->with_aux = false;
   const int width = static_cast<int>(view.camera.width), height = static_cast<int>(view.camera.height);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->eye.framebuffer.Get());
+  const GLuint frame = impl_->eye.framebuffer.Get();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, frame);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   std::vector<uint8_t> bytes(static_cast<size_t>(width) * height * 4);
-  std::vector<float> aux(static_cast<size_t>(width) * height * 4);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, bytes.data());
-  glReadBuffer(GL_COLOR_ATTACHMENT1);
-  glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, aux.data());
   CheckGlError("SceneRenderer::Render read back");
-  FrameResult result{Image(width, height, 3), Image(width, height, 4), Image()};
+  FrameResult result{Image(width, height, 3), ReadFloatAttachment(frame, GL_COLOR_ATTACHMENT1, width, height, 4),
+                     Image()};
   for (int y = 0; y < height; ++y) {
     const size_t row = static_cast<size_t>(height - 1 - y) * width;  // GL rows go bottom-up.
     for (int x = 0; x < width; ++x) {
       for (int c = 0; c < 3; ++c) result.color.At(x, y, c) = bytes[(row + x) * 4 + c] / 255.0f;
-      for (int c = 0; c < 4; ++c) result.aux.At(x, y, c) = aux[(row + x) * 4 + c];
     }
   }
-  if (settings.DrawnInFloat()) result.linear = ReadLinearFrame(impl_->tone_mapper.LinearFramebuffer(), width, height);
+  if (settings.DrawnInFloat()) {
+    result.linear =
+        ReadFloatAttachment(impl_->tone_mapper.LinearFramebuffer(), GL_COLOR_ATTACHMENT0, width, height, 3);
+  }
   return result;
 }
 
